@@ -1,0 +1,181 @@
+//! The global descriptor-indexed set (kajiya, Sascha Willems' `descriptorindexing`): every patch texture lives in a
+//! slot of one runtime array, read with `nonuniformEXT` from any shader. Binding 0 is the storage-image view of a
+//! slot (compute kernels write river data), binding 1 the sampled view of the same slot (vertex and fragment
+//! shaders read it). Both are PARTIALLY_BOUND and UPDATE_AFTER_BIND; binding 1 has a variable descriptor count.
+
+use ash::vk;
+
+use super::{Context, GpuError, Image, VkResultExt};
+
+pub const STORAGE_IMAGES: u32 = 0;
+pub const SAMPLED_IMAGES: u32 = 1;
+
+pub struct Bindless {
+    pub layout: vk::DescriptorSetLayout,
+    pool: vk::DescriptorPool,
+    pub set: vk::DescriptorSet,
+    sampler: vk::Sampler,
+    pub capacity: u32,
+    free: Vec<u32>,
+}
+
+/// A slot index in the bindless arrays, as shaders see it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Slot(pub u32);
+
+impl Bindless {
+    /// Creates the set with `capacity` slots (clamped to the device's update-after-bind limits).
+    pub fn new(ctx: &Context, capacity: u32) -> Result<Self, GpuError> {
+        let mut props12 = vk::PhysicalDeviceVulkan12Properties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut props12);
+        // SAFETY: plain query.
+        unsafe {
+            ctx.instance
+                .get_physical_device_properties2(ctx.physical, &mut props2)
+        };
+        let limit = props12
+            .max_descriptor_set_update_after_bind_storage_images
+            .min(props12.max_descriptor_set_update_after_bind_sampled_images)
+            .min(props12.max_per_stage_descriptor_update_after_bind_storage_images)
+            .min(props12.max_per_stage_descriptor_update_after_bind_sampled_images);
+        let capacity = capacity.min(limit).max(1);
+
+        let stages = vk::ShaderStageFlags::COMPUTE
+            | vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::GEOMETRY
+            | vk::ShaderStageFlags::FRAGMENT;
+        let bindings = [
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(STORAGE_IMAGES)
+                .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                .descriptor_count(capacity)
+                .stage_flags(stages),
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(SAMPLED_IMAGES)
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .descriptor_count(capacity)
+                .stage_flags(stages),
+        ];
+        let common = vk::DescriptorBindingFlags::PARTIALLY_BOUND
+            | vk::DescriptorBindingFlags::UPDATE_AFTER_BIND;
+        let flags = [
+            common,
+            common | vk::DescriptorBindingFlags::VARIABLE_DESCRIPTOR_COUNT,
+        ];
+        let mut flag_info =
+            vk::DescriptorSetLayoutBindingFlagsCreateInfo::default().binding_flags(&flags);
+        let layout_info = vk::DescriptorSetLayoutCreateInfo::default()
+            .flags(vk::DescriptorSetLayoutCreateFlags::UPDATE_AFTER_BIND_POOL)
+            .bindings(&bindings)
+            .push_next(&mut flag_info);
+        // SAFETY: valid create infos; destroyed in `destroy`.
+        let layout = unsafe { ctx.device.create_descriptor_set_layout(&layout_info, None) }
+            .vk("vkCreateDescriptorSetLayout")?;
+        ctx.set_name(layout, "bindless layout");
+        let sizes = [
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_IMAGE,
+                descriptor_count: capacity,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                descriptor_count: capacity,
+            },
+        ];
+        let pool_info = vk::DescriptorPoolCreateInfo::default()
+            .flags(vk::DescriptorPoolCreateFlags::UPDATE_AFTER_BIND)
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
+            .vk("vkCreateDescriptorPool")?;
+        let counts = [capacity];
+        let mut variable = vk::DescriptorSetVariableDescriptorCountAllocateInfo::default()
+            .descriptor_counts(&counts);
+        let layouts = [layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(pool)
+            .set_layouts(&layouts)
+            .push_next(&mut variable);
+        let set = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+            .vk("vkAllocateDescriptorSets")?[0];
+        ctx.set_name(set, "bindless set");
+        let sampler_info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        let sampler =
+            unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
+        ctx.set_name(sampler, "bindless linear clamp sampler");
+        Ok(Self {
+            layout,
+            pool,
+            set,
+            sampler,
+            capacity,
+            free: (0..capacity).rev().collect(),
+        })
+    }
+
+    /// Takes a free slot, or `None` when all are in use.
+    pub fn allocate(&mut self) -> Option<Slot> {
+        self.free.pop().map(Slot)
+    }
+
+    /// Returns a slot. Its old descriptors stay until overwritten; PARTIALLY_BOUND makes that legal.
+    pub fn release(&mut self, slot: Slot) {
+        debug_assert!(!self.free.contains(&slot.0));
+        self.free.push(slot.0);
+    }
+
+    pub fn free_slots(&self) -> usize {
+        self.free.len()
+    }
+
+    /// Points `slot` at `image`: as a storage image in GENERAL layout (if `storage`), and as a sampled image in
+    /// `sampled_layout`.
+    pub fn write(
+        &self,
+        ctx: &Context,
+        slot: Slot,
+        image: &Image,
+        storage: bool,
+        sampled_layout: vk::ImageLayout,
+    ) {
+        let storage_info = [vk::DescriptorImageInfo::default()
+            .image_view(image.view)
+            .image_layout(vk::ImageLayout::GENERAL)];
+        let sampled_info = [vk::DescriptorImageInfo::default()
+            .image_view(image.view)
+            .image_layout(sampled_layout)
+            .sampler(self.sampler)];
+        let mut writes = vec![vk::WriteDescriptorSet::default()
+            .dst_set(self.set)
+            .dst_binding(SAMPLED_IMAGES)
+            .dst_array_element(slot.0)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .image_info(&sampled_info)];
+        if storage {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.set)
+                    .dst_binding(STORAGE_IMAGES)
+                    .dst_array_element(slot.0)
+                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .image_info(&storage_info),
+            );
+        }
+        // SAFETY: UPDATE_AFTER_BIND permits updates while the set is bound; the slot is not used by pending work.
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        // SAFETY: called after the device finished all work using the set (wait_idle at shutdown).
+        unsafe {
+            ctx.device.destroy_sampler(self.sampler, None);
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            ctx.device.destroy_descriptor_set_layout(self.layout, None);
+        }
+    }
+}

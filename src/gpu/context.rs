@@ -1,0 +1,524 @@
+//! Instance, debug messenger, physical-device choice, logical device, queue and memory allocator.
+
+use std::{
+    ffi::{c_void, CStr},
+    mem::ManuallyDrop,
+    sync::Mutex,
+};
+
+use ash::{ext, vk};
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+
+use super::{
+    features, memory::DeletionQueue, submit::Timeline, FeatureReport, GpuError, VkResultExt,
+};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to create a [`Context`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Enable the Khronos validation layer and collect its errors.
+    pub validation: bool,
+    /// Choose the first device whose name contains this (case-insensitive).
+    pub adapter: Option<String>,
+    /// Extra instance extensions (surface extensions for a window).
+    pub instance_extensions: Vec<&'static CStr>,
+    /// Enable `VK_KHR_swapchain` on the device.
+    pub swapchain: bool,
+}
+
+impl ContextOptions {
+    /// Options from the environment: `RIVERPLANET_VALIDATION` (0/1, default on in debug builds) and
+    /// `RIVERPLANET_ADAPTER`.
+    pub fn from_env() -> Self {
+        let validation = match std::env::var("RIVERPLANET_VALIDATION").as_deref() {
+            Ok("0") | Ok("false") | Ok("off") => false,
+            Ok(_) => true,
+            Err(_) => cfg!(debug_assertions),
+        };
+        Self {
+            validation,
+            adapter: std::env::var("RIVERPLANET_ADAPTER")
+                .ok()
+                .filter(|s| !s.is_empty()),
+            ..Default::default()
+        }
+    }
+}
+
+/// What `riverplanet info` shows of one physical device.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AdapterInfo {
+    pub name: String,
+    pub device_type: String,
+    pub api_version: String,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub features: FeatureReport,
+    pub chosen: bool,
+}
+
+/// Validation messages collected by the debug messenger. Errors make every GPU test fail.
+#[derive(Default)]
+pub struct ValidationLog {
+    errors: Mutex<Vec<String>>,
+}
+
+/// The device and everything needed to use it. Shared by reference; internally synchronised.
+pub struct Context {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    debug_instance: Option<ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    debug_device: Option<ext::debug_utils::Device>,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue_family: u32,
+    queue: Mutex<vk::Queue>,
+    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub(crate) deletion: DeletionQueue,
+    pub(crate) timeline: Timeline,
+    pub properties: vk::PhysicalDeviceProperties,
+    pub timestamp_valid_bits: u32,
+    validation_log: Box<ValidationLog>,
+    validation_enabled: bool,
+    pub adapter: AdapterInfo,
+}
+
+fn load_entry() -> Result<ash::Entry, GpuError> {
+    // SAFETY: loading libvulkan runs its initialisers; nothing else of ours runs concurrently with it here.
+    unsafe { ash::Entry::load() }.map_err(|e| GpuError::Loader(e.to_string()))
+}
+
+fn create_instance(
+    entry: &ash::Entry,
+    options: &ContextOptions,
+) -> Result<(ash::Instance, bool), GpuError> {
+    // SAFETY: plain queries on a loaded entry.
+    let layers = unsafe { entry.enumerate_instance_layer_properties() }
+        .vk("vkEnumerateInstanceLayerProperties")?;
+    let has_validation = layers
+        .iter()
+        .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER));
+    let validation = options.validation && has_validation;
+    if options.validation && !has_validation {
+        log::warn!("validation requested but VK_LAYER_KHRONOS_validation is not installed (vulkan-validationlayers)");
+    }
+    let exts = unsafe { entry.enumerate_instance_extension_properties(None) }
+        .vk("vkEnumerateInstanceExtensionProperties")?;
+    let has_debug_utils = exts
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(ext::debug_utils::NAME));
+
+    let mut ext_names: Vec<*const i8> = options
+        .instance_extensions
+        .iter()
+        .map(|e| e.as_ptr())
+        .collect();
+    if has_debug_utils {
+        ext_names.push(ext::debug_utils::NAME.as_ptr());
+    }
+    let layer_names: Vec<*const i8> = if validation {
+        vec![VALIDATION_LAYER.as_ptr()]
+    } else {
+        vec![]
+    };
+    let app = vk::ApplicationInfo::default()
+        .application_name(c"riverplanet")
+        .engine_name(c"riverplanet")
+        .api_version(vk::API_VERSION_1_3);
+    let info = vk::InstanceCreateInfo::default()
+        .application_info(&app)
+        .enabled_extension_names(&ext_names)
+        .enabled_layer_names(&layer_names);
+    // SAFETY: every pointer in `info` outlives the call.
+    let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
+    Ok((instance, validation && has_debug_utils))
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // Never unwind across FFI: a panic here is caught and dropped.
+    let _ = std::panic::catch_unwind(|| {
+        // SAFETY: the layer passes valid callback data for the duration of the call.
+        let message = unsafe { data.as_ref() }
+            .and_then(|d| unsafe { d.message_as_c_str() })
+            .map(|m| m.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+            log::error!("[vulkan {kind:?}] {message}");
+            // SAFETY: `user` is the boxed ValidationLog owned by the Context, alive until the messenger is destroyed.
+            if let Some(log) = unsafe { (user as *const ValidationLog).as_ref() } {
+                if let Ok(mut errors) = log.errors.lock() {
+                    errors.push(message);
+                }
+            }
+        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+            log::warn!("[vulkan {kind:?}] {message}");
+        } else {
+            log::debug!("[vulkan {kind:?}] {message}");
+        }
+    });
+    vk::FALSE
+}
+
+fn graphics_compute_family(instance: &ash::Instance, physical: vk::PhysicalDevice) -> Option<u32> {
+    // SAFETY: plain query.
+    let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+    families
+        .iter()
+        .position(|f| {
+            f.queue_flags
+                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        })
+        .map(|i| i as u32)
+}
+
+fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice) -> AdapterInfo {
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    // SAFETY: plain query with a chain on this stack frame.
+    unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
+    let p = props2.properties;
+    let v = p.api_version;
+    let family = graphics_compute_family(instance, physical);
+    AdapterInfo {
+        name: p
+            .device_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        device_type: format!("{:?}", p.device_type),
+        api_version: format!(
+            "{}.{}.{}",
+            vk::api_version_major(v),
+            vk::api_version_minor(v),
+            vk::api_version_patch(v)
+        ),
+        driver_name: driver
+            .driver_name_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        driver_info: driver
+            .driver_info_as_c_str()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        features: features::query(instance, physical, family),
+        chosen: false,
+    }
+}
+
+fn type_rank(device_type: &str) -> u32 {
+    match device_type {
+        "DISCRETE_GPU" => 4,
+        "INTEGRATED_GPU" => 3,
+        "VIRTUAL_GPU" => 2,
+        "CPU" => 1,
+        _ => 0,
+    }
+}
+
+/// Every device's description, its handle, and the index of the chosen one.
+type Enumeration = (Vec<AdapterInfo>, Vec<vk::PhysicalDevice>, Option<usize>);
+
+/// Lists every device and marks the one `options` chooses: the adapter filter first, then discrete GPUs before
+/// integrated, virtual and CPU devices, among devices with every required feature.
+fn choose(
+    instance: &ash::Instance,
+    options: &ContextOptions,
+) -> Result<Enumeration, GpuError> {
+    // SAFETY: plain query.
+    let physicals =
+        unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    let mut infos: Vec<AdapterInfo> = physicals.iter().map(|&p| describe(instance, p)).collect();
+    let matches = |info: &AdapterInfo| match &options.adapter {
+        Some(f) => info.name.to_lowercase().contains(&f.to_lowercase()),
+        None => true,
+    };
+    let chosen = infos
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| matches(i))
+        .max_by_key(|(_, i)| (i.features.all_supported(), type_rank(&i.device_type)))
+        .map(|(idx, _)| idx);
+    if let Some(idx) = chosen {
+        infos[idx].chosen = true;
+    }
+    Ok((infos, physicals, chosen))
+}
+
+/// Lists the devices without creating one (for `riverplanet info`). Returns the instance version too.
+pub fn enumerate(options: &ContextOptions) -> Result<(String, Vec<AdapterInfo>), GpuError> {
+    let entry = load_entry()?;
+    // SAFETY: plain query.
+    let version = unsafe { entry.try_enumerate_instance_version() }
+        .vk("vkEnumerateInstanceVersion")?
+        .unwrap_or(vk::API_VERSION_1_0);
+    let (instance, _) = create_instance(
+        &entry,
+        &ContextOptions {
+            validation: false,
+            ..options.clone()
+        },
+    )?;
+    let result = choose(&instance, options).map(|(infos, _, _)| infos);
+    // SAFETY: nothing was created from this instance.
+    unsafe { instance.destroy_instance(None) };
+    let version = format!(
+        "{}.{}.{}",
+        vk::api_version_major(version),
+        vk::api_version_minor(version),
+        vk::api_version_patch(version)
+    );
+    Ok((version, result?))
+}
+
+impl Context {
+    /// Creates the instance and device. Fails with a named error when no device or a required feature is missing.
+    pub fn new(options: &ContextOptions) -> Result<Self, GpuError> {
+        let entry = load_entry()?;
+        let (instance, validation_enabled) = create_instance(&entry, options)?;
+        match Self::with_instance(entry, instance.clone(), validation_enabled, options) {
+            Ok(ctx) => Ok(ctx),
+            Err(e) => {
+                // SAFETY: with_instance destroyed everything it created before failing.
+                unsafe { instance.destroy_instance(None) };
+                Err(e)
+            }
+        }
+    }
+
+    fn with_instance(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        validation_enabled: bool,
+        options: &ContextOptions,
+    ) -> Result<Self, GpuError> {
+        let (infos, physicals, chosen) = choose(&instance, options)?;
+        for info in &infos {
+            log::info!(
+                "device: {} ({}, Vulkan {}, driver {} {}){}",
+                info.name,
+                info.device_type,
+                info.api_version,
+                info.driver_name,
+                info.driver_info,
+                if info.chosen { " <- chosen" } else { "" }
+            );
+        }
+        let Some(idx) = chosen else {
+            return Err(match &options.adapter {
+                Some(filter) if !infos.is_empty() => GpuError::NoMatchingAdapter {
+                    filter: filter.clone(),
+                    available: infos
+                        .iter()
+                        .map(|i| i.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                },
+                _ => GpuError::NoDevice,
+            });
+        };
+        let adapter = infos[idx].clone();
+        if !adapter.features.all_supported() {
+            return Err(GpuError::MissingFeature {
+                device: adapter.name.clone(),
+                missing: adapter.features.missing().join(", "),
+            });
+        }
+        let physical = physicals[idx];
+        let queue_family =
+            graphics_compute_family(&instance, physical).ok_or(GpuError::NoDevice)?;
+
+        let validation_log = Box::<ValidationLog>::default();
+        let (debug_instance, messenger) = if validation_enabled {
+            let debug = ext::debug_utils::Instance::new(&entry, &instance);
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(
+                    vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                        | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+                )
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                )
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(&*validation_log as *const ValidationLog as *mut c_void);
+            // SAFETY: the user data box outlives the messenger (destroyed first in Drop).
+            let messenger = unsafe { debug.create_debug_utils_messenger(&info, None) }
+                .vk("vkCreateDebugUtilsMessengerEXT")?;
+            (Some(debug), messenger)
+        } else {
+            (None, vk::DebugUtilsMessengerEXT::null())
+        };
+
+        let mut enabled = features::EnabledFeatures::required();
+        let priorities = [1.0f32];
+        let queue_info = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let mut device_exts: Vec<*const i8> = vec![];
+        if options.swapchain {
+            device_exts.push(ash::khr::swapchain::NAME.as_ptr());
+        }
+        let mut features2 = vk::PhysicalDeviceFeatures2::default()
+            .features(enabled.core)
+            .push_next(&mut enabled.v12)
+            .push_next(&mut enabled.v13);
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_extension_names(&device_exts)
+            .push_next(&mut features2);
+        // SAFETY: every pointer in `device_info` outlives the call; features were checked above.
+        let device = unsafe { instance.create_device(physical, &device_info, None) };
+        let device = match device.vk("vkCreateDevice") {
+            Ok(d) => d,
+            Err(e) => {
+                if let Some(debug) = &debug_instance {
+                    // SAFETY: created above, unused elsewhere.
+                    unsafe { debug.destroy_debug_utils_messenger(messenger, None) };
+                }
+                return Err(e);
+            }
+        };
+        // SAFETY: family index 0 of the family we created.
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let properties = unsafe { instance.get_physical_device_properties(physical) };
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let timestamp_valid_bits = families[queue_family as usize].timestamp_valid_bits;
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|source| GpuError::Allocation {
+            name: "allocator".into(),
+            source,
+        })?;
+        let timeline = Timeline::new(&device)?;
+        let debug_device =
+            validation_enabled.then(|| ext::debug_utils::Device::new(&instance, &device));
+        log::info!(
+            "using '{}' (validation {})",
+            adapter.name,
+            if validation_enabled { "on" } else { "off" }
+        );
+        Ok(Self {
+            _entry: entry,
+            instance,
+            debug_instance,
+            messenger,
+            debug_device,
+            physical,
+            device,
+            queue_family,
+            queue: Mutex::new(queue),
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            deletion: DeletionQueue::default(),
+            timeline,
+            properties,
+            timestamp_valid_bits,
+            validation_log,
+            validation_enabled,
+            adapter,
+        })
+    }
+
+    /// Whether the validation layer is active (and its errors are being collected).
+    pub fn validation_enabled(&self) -> bool {
+        self.validation_enabled
+    }
+
+    /// Validation errors reported so far. GPU tests assert this is empty.
+    pub fn validation_errors(&self) -> Vec<String> {
+        self.validation_log
+            .errors
+            .lock()
+            .map(|e| e.clone())
+            .unwrap_or_default()
+    }
+
+    /// Gives `handle` a name for validation messages and capture tools (RenderDoc).
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Some(debug) = &self.debug_device else {
+            return;
+        };
+        let Ok(name) = std::ffi::CString::new(name) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
+        // SAFETY: the handle belongs to this device; naming failure is harmless, so the result is ignored.
+        let _ = unsafe { debug.set_debug_utils_object_name(&info) };
+    }
+
+    /// Opens a debug label region in `cmd` (shown by capture tools); close it with [`Self::end_label`].
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        let Some(debug) = &self.debug_device else {
+            return;
+        };
+        let Ok(name) = std::ffi::CString::new(name) else {
+            return;
+        };
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
+        // SAFETY: cmd is recording.
+        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(debug) = &self.debug_device {
+            // SAFETY: paired with begin_label on a recording command buffer.
+            unsafe { debug.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+
+    pub(crate) fn queue(&self) -> std::sync::MutexGuard<'_, vk::Queue> {
+        self.queue.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Waits until the device is idle and frees everything retired. For shutdown and tests, not per frame.
+    pub fn wait_idle(&self) -> Result<(), GpuError> {
+        let _queue = self.queue();
+        // SAFETY: the queue lock is held, so no submission races with the wait.
+        unsafe { self.device.device_wait_idle() }.vk("vkDeviceWaitIdle")?;
+        drop(_queue);
+        self.collect_garbage();
+        Ok(())
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        // Shutdown order (STYLE.md): wait idle, flush deferred deletions, drop the allocator (it reports leaks),
+        // destroy device, messenger, instance.
+        if let Err(e) = self.wait_idle() {
+            log::error!("shutdown: {e}");
+        }
+        self.deletion.flush_all(&self.device, &self.allocator);
+        self.timeline.destroy(&self.device);
+        // SAFETY: nothing else uses the allocator after this point.
+        let allocator = unsafe { ManuallyDrop::take(&mut self.allocator) };
+        if let Ok(allocator) = allocator.into_inner() {
+            allocator.report_memory_leaks(log::Level::Warn);
+            drop(allocator);
+        }
+        // SAFETY: all child objects were destroyed above; reverse creation order.
+        unsafe {
+            self.device.destroy_device(None);
+            if let Some(debug) = &self.debug_instance {
+                debug.destroy_debug_utils_messenger(self.messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}

@@ -1,0 +1,149 @@
+//! The device features riverplanet requires, negotiated in one place (wgpu-hal's `PhysicalDeviceFeatures`):
+//! queried once, reported by `riverplanet info`, enabled exactly as listed, and a missing one is an error naming it.
+
+use ash::vk;
+
+/// One required capability and whether the device has it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FeatureCheck {
+    pub name: &'static str,
+    pub supported: bool,
+}
+
+/// The required features of one physical device, each yes/no.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FeatureReport {
+    pub checks: Vec<FeatureCheck>,
+}
+
+impl FeatureReport {
+    pub fn all_supported(&self) -> bool {
+        self.checks.iter().all(|c| c.supported)
+    }
+
+    pub fn missing(&self) -> Vec<&'static str> {
+        self.checks
+            .iter()
+            .filter(|c| !c.supported)
+            .map(|c| c.name)
+            .collect()
+    }
+}
+
+/// Queries `physical` for every required feature. `queue_family` is the family that will be used.
+pub fn query(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    queue_family: Option<u32>,
+) -> FeatureReport {
+    let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default()
+        .push_next(&mut v12)
+        .push_next(&mut v13);
+    // SAFETY: `physical` comes from this instance; the chain lives on this stack frame.
+    unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+    let core = f2.features;
+    // SAFETY: as above.
+    let props = unsafe { instance.get_physical_device_properties(physical) };
+    let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+    let family = queue_family.and_then(|i| families.get(i as usize));
+    let api_ok = props.api_version >= vk::API_VERSION_1_3;
+
+    let b = |x: vk::Bool32| x == vk::TRUE;
+    let checks = vec![
+        ("Vulkan 1.3", api_ok),
+        ("graphics+compute queue", family.is_some()),
+        ("geometryShader", b(core.geometry_shader)),
+        ("fillModeNonSolid (wireframe)", b(core.fill_mode_non_solid)),
+        ("descriptorIndexing", b(v12.descriptor_indexing)),
+        ("runtimeDescriptorArray", b(v12.runtime_descriptor_array)),
+        (
+            "descriptorBindingPartiallyBound",
+            b(v12.descriptor_binding_partially_bound),
+        ),
+        (
+            "descriptorBindingVariableDescriptorCount",
+            b(v12.descriptor_binding_variable_descriptor_count),
+        ),
+        (
+            "descriptorBindingSampledImageUpdateAfterBind",
+            b(v12.descriptor_binding_sampled_image_update_after_bind),
+        ),
+        (
+            "descriptorBindingStorageImageUpdateAfterBind",
+            b(v12.descriptor_binding_storage_image_update_after_bind),
+        ),
+        (
+            "descriptorBindingStorageBufferUpdateAfterBind",
+            b(v12.descriptor_binding_storage_buffer_update_after_bind),
+        ),
+        (
+            "shaderSampledImageArrayNonUniformIndexing",
+            b(v12.shader_sampled_image_array_non_uniform_indexing),
+        ),
+        (
+            "shaderStorageImageArrayNonUniformIndexing",
+            b(v12.shader_storage_image_array_non_uniform_indexing),
+        ),
+        (
+            "shaderStorageBufferArrayNonUniformIndexing",
+            b(v12.shader_storage_buffer_array_non_uniform_indexing),
+        ),
+        ("timelineSemaphore", b(v12.timeline_semaphore)),
+        ("hostQueryReset", b(v12.host_query_reset)),
+        ("scalarBlockLayout", b(v12.scalar_block_layout)),
+        ("synchronization2", b(v13.synchronization2)),
+        ("dynamicRendering", b(v13.dynamic_rendering)),
+        (
+            "maintenance4 (LocalSizeId in SPIR-V 1.6)",
+            b(v13.maintenance4),
+        ),
+        (
+            "timestamps on the queue",
+            family.is_some_and(|f| f.timestamp_valid_bits > 0)
+                && props.limits.timestamp_period > 0.0,
+        ),
+    ];
+    FeatureReport {
+        checks: checks
+            .into_iter()
+            .map(|(name, supported)| FeatureCheck { name, supported })
+            .collect(),
+    }
+}
+
+/// The feature structs to chain into `VkDeviceCreateInfo`, with exactly the required features enabled.
+pub struct EnabledFeatures {
+    pub core: vk::PhysicalDeviceFeatures,
+    pub v12: vk::PhysicalDeviceVulkan12Features<'static>,
+    pub v13: vk::PhysicalDeviceVulkan13Features<'static>,
+}
+
+impl EnabledFeatures {
+    pub fn required() -> Self {
+        Self {
+            core: vk::PhysicalDeviceFeatures::default()
+                .geometry_shader(true)
+                .fill_mode_non_solid(true),
+            v12: vk::PhysicalDeviceVulkan12Features::default()
+                .descriptor_indexing(true)
+                .runtime_descriptor_array(true)
+                .descriptor_binding_partially_bound(true)
+                .descriptor_binding_variable_descriptor_count(true)
+                .descriptor_binding_sampled_image_update_after_bind(true)
+                .descriptor_binding_storage_image_update_after_bind(true)
+                .descriptor_binding_storage_buffer_update_after_bind(true)
+                .shader_sampled_image_array_non_uniform_indexing(true)
+                .shader_storage_image_array_non_uniform_indexing(true)
+                .shader_storage_buffer_array_non_uniform_indexing(true)
+                .timeline_semaphore(true)
+                .host_query_reset(true)
+                .scalar_block_layout(true),
+            v13: vk::PhysicalDeviceVulkan13Features::default()
+                .synchronization2(true)
+                .dynamic_rendering(true)
+                .maintenance4(true),
+        }
+    }
+}

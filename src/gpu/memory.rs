@@ -1,0 +1,321 @@
+//! Named buffers and images on gpu-allocator memory, and deferred destruction: a retired resource is freed only
+//! after the GPU has finished every submission made before it was retired (Granite's per-frame lists, keyed here
+//! by timeline-semaphore value).
+
+use std::sync::Mutex;
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
+pub use gpu_allocator::MemoryLocation;
+
+use super::{Context, GpuError, VkResultExt};
+
+/// A buffer request. `name` goes to the debug-utils object name and to the allocation.
+#[derive(Clone, Debug)]
+pub struct BufferDesc<'a> {
+    pub name: &'a str,
+    pub size: u64,
+    pub usage: vk::BufferUsageFlags,
+    pub location: MemoryLocation,
+}
+
+pub struct Buffer {
+    pub raw: vk::Buffer,
+    pub size: u64,
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+impl Buffer {
+    /// The mapped bytes of a host-visible buffer.
+    pub fn mapped(&self) -> Option<&[u8]> {
+        self.allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .map(|s| &s[..self.size as usize])
+    }
+
+    pub fn mapped_mut(&mut self) -> Option<&mut [u8]> {
+        let size = self.size as usize;
+        self.allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .map(|s| &mut s[..size])
+    }
+
+    /// Writes `data` at `offset` into a host-visible buffer; errors if the buffer is not mapped or too small.
+    pub fn write<T: bytemuck::Pod>(&mut self, offset: usize, data: &[T]) -> Result<(), GpuError> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let name = self.name.clone();
+        let dst = self
+            .mapped_mut()
+            .ok_or_else(|| GpuError::Invalid(format!("buffer '{name}' is not host-visible")))?;
+        let end = offset + bytes.len();
+        if end > dst.len() {
+            return Err(GpuError::Invalid(format!(
+                "write of {} bytes at {offset} overflows buffer '{name}' of {} bytes",
+                bytes.len(),
+                dst.len()
+            )));
+        }
+        dst[offset..end].copy_from_slice(bytes);
+        Ok(())
+    }
+}
+
+/// An image request: 2D, with `layers` array layers and one mip level.
+#[derive(Clone, Debug)]
+pub struct ImageDesc<'a> {
+    pub name: &'a str,
+    pub extent: vk::Extent2D,
+    pub layers: u32,
+    pub format: vk::Format,
+    pub usage: vk::ImageUsageFlags,
+    pub aspect: vk::ImageAspectFlags,
+}
+
+pub struct Image {
+    pub raw: vk::Image,
+    pub view: vk::ImageView,
+    pub extent: vk::Extent2D,
+    pub layers: u32,
+    pub format: vk::Format,
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+impl Image {
+    /// The subresource range of the whole image.
+    pub fn range(&self) -> vk::ImageSubresourceRange {
+        let aspect = if self.format == vk::Format::D32_SFLOAT {
+            vk::ImageAspectFlags::DEPTH
+        } else {
+            vk::ImageAspectFlags::COLOR
+        };
+        vk::ImageSubresourceRange::default()
+            .aspect_mask(aspect)
+            .level_count(1)
+            .layer_count(self.layers)
+    }
+}
+
+enum Retired {
+    Buffer(vk::Buffer, Option<Allocation>),
+    Image(vk::Image, vk::ImageView, Option<Allocation>),
+    Pool(vk::CommandPool),
+    QueryPool(vk::QueryPool),
+}
+
+/// Resources waiting for the GPU to finish with them, each tagged with the timeline value that must complete first.
+#[derive(Default)]
+pub(crate) struct DeletionQueue {
+    pending: Mutex<Vec<(u64, Retired)>>,
+}
+
+impl DeletionQueue {
+    fn push(&self, after: u64, item: Retired) {
+        self.pending
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((after, item));
+    }
+
+    /// Frees every resource whose guarding submission has completed.
+    fn collect(&self, device: &ash::Device, allocator: &Mutex<Allocator>, completed: u64) {
+        let ready: Vec<Retired> = {
+            let mut pending = self.pending.lock().unwrap_or_else(|e| e.into_inner());
+            let (ready, keep): (Vec<_>, Vec<_>) =
+                pending.drain(..).partition(|(v, _)| *v <= completed);
+            *pending = keep;
+            ready.into_iter().map(|(_, r)| r).collect()
+        };
+        if ready.is_empty() {
+            return;
+        }
+        let mut allocator = allocator.lock().unwrap_or_else(|e| e.into_inner());
+        for item in ready {
+            // SAFETY: the GPU finished every submission that could use these objects (timeline value reached).
+            unsafe {
+                match item {
+                    Retired::Buffer(b, a) => {
+                        device.destroy_buffer(b, None);
+                        if let Some(a) = a {
+                            let _ = allocator.free(a);
+                        }
+                    }
+                    Retired::Image(i, v, a) => {
+                        device.destroy_image_view(v, None);
+                        device.destroy_image(i, None);
+                        if let Some(a) = a {
+                            let _ = allocator.free(a);
+                        }
+                    }
+                    Retired::Pool(p) => device.destroy_command_pool(p, None),
+                    Retired::QueryPool(q) => device.destroy_query_pool(q, None),
+                }
+            }
+        }
+    }
+
+    pub(crate) fn flush_all(&self, device: &ash::Device, allocator: &Mutex<Allocator>) {
+        self.collect(device, allocator, u64::MAX);
+    }
+}
+
+impl Context {
+    fn allocate(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+    ) -> Result<Allocation, GpuError> {
+        self.allocator
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|source| GpuError::Allocation {
+                name: name.to_string(),
+                source,
+            })
+    }
+
+    pub fn create_buffer(&self, desc: &BufferDesc) -> Result<Buffer, GpuError> {
+        let info = vk::BufferCreateInfo::default()
+            .size(desc.size.max(4))
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid create info; the buffer is destroyed through the deletion queue.
+        let raw = unsafe { self.device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
+        let requirements = unsafe { self.device.get_buffer_memory_requirements(raw) };
+        let allocation = match self.allocate(desc.name, requirements, desc.location, true) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { self.device.destroy_buffer(raw, None) };
+                return Err(e);
+            }
+        };
+        // SAFETY: fresh allocation satisfying the buffer's requirements.
+        unsafe {
+            self.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .vk("vkBindBufferMemory")?;
+        self.set_name(raw, desc.name);
+        Ok(Buffer {
+            raw,
+            size: desc.size,
+            name: desc.name.to_string(),
+            allocation: Some(allocation),
+        })
+    }
+
+    pub fn create_image(&self, desc: &ImageDesc) -> Result<Image, GpuError> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D {
+                width: desc.extent.width,
+                height: desc.extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(desc.layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid create info.
+        let raw = unsafe { self.device.create_image(&info, None) }.vk("vkCreateImage")?;
+        let requirements = unsafe { self.device.get_image_memory_requirements(raw) };
+        let allocation =
+            match self.allocate(desc.name, requirements, MemoryLocation::GpuOnly, false) {
+                Ok(a) => a,
+                Err(e) => {
+                    unsafe { self.device.destroy_image(raw, None) };
+                    return Err(e);
+                }
+            };
+        unsafe {
+            self.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())
+        }
+        .vk("vkBindImageMemory")?;
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(view_type)
+            .format(desc.format)
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(desc.aspect)
+                    .level_count(1)
+                    .layer_count(desc.layers),
+            );
+        let view =
+            unsafe { self.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        self.set_name(raw, desc.name);
+        self.set_name(view, desc.name);
+        Ok(Image {
+            raw,
+            view,
+            extent: desc.extent,
+            layers: desc.layers,
+            format: desc.format,
+            name: desc.name.to_string(),
+            allocation: Some(allocation),
+        })
+    }
+
+    /// Frees `buffer` once every submission made so far has completed.
+    pub fn retire_buffer(&self, mut buffer: Buffer) {
+        self.deletion.push(
+            self.timeline.last_submitted(),
+            Retired::Buffer(buffer.raw, buffer.allocation.take()),
+        );
+    }
+
+    /// Frees `image` once every submission made so far has completed.
+    pub fn retire_image(&self, mut image: Image) {
+        self.deletion.push(
+            self.timeline.last_submitted(),
+            Retired::Image(image.raw, image.view, image.allocation.take()),
+        );
+    }
+
+    pub(crate) fn retire_command_pool(&self, pool: vk::CommandPool) {
+        self.deletion
+            .push(self.timeline.last_submitted(), Retired::Pool(pool));
+    }
+
+    pub(crate) fn retire_query_pool(&self, pool: vk::QueryPool) {
+        self.deletion
+            .push(self.timeline.last_submitted(), Retired::QueryPool(pool));
+    }
+
+    /// Frees retired resources whose submissions have completed. Cheap; call once per frame.
+    pub fn collect_garbage(&self) {
+        let completed = self.timeline.completed(&self.device).unwrap_or(0);
+        self.deletion
+            .collect(&self.device, &self.allocator, completed);
+    }
+
+    /// Bytes allocated from the device, as gpu-allocator reports them.
+    pub fn allocated_bytes(&self) -> u64 {
+        self.allocator
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .generate_report()
+            .total_allocated_bytes
+    }
+}

@@ -1,0 +1,63 @@
+//! The Vulkan backend: the only module that imports `ash`. It knows nothing of planets.
+//!
+//! One file per concern, as in wgpu-hal: [`context`] (instance, device choice, device, queue, allocator),
+//! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
+//! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`bindless`] (the global
+//! descriptor-indexed set), [`pipeline`] (shader modules and pipelines), [`profiler`] (timestamp scopes).
+
+pub mod bindless;
+pub mod context;
+pub mod features;
+pub mod memory;
+pub mod pipeline;
+pub mod profiler;
+pub mod submit;
+
+pub use ash::vk;
+pub use context::{AdapterInfo, Context, ContextOptions};
+pub use features::FeatureReport;
+pub use memory::{Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};
+pub use profiler::{Profiler, ScopeTiming};
+pub use submit::{Recorder, SubmissionId};
+
+/// Everything that can go wrong in the backend. The failing Vulkan call travels with its result.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("cannot load the Vulkan loader (libvulkan.so.1): {0}; install libvulkan1 and a driver (tools/setup)")]
+    Loader(String),
+    #[error("{call} failed: {result}")]
+    Vk {
+        call: &'static str,
+        result: vk::Result,
+    },
+    #[error("the GPU device was lost during {call}; restart the program (driver reset or crash)")]
+    DeviceLost { call: &'static str },
+    #[error("no Vulkan device found; install a driver (tools/setup installs Mesa lavapipe)")]
+    NoDevice,
+    #[error("no Vulkan device name contains '{filter}' (--adapter / RIVERPLANET_ADAPTER); devices: {available}")]
+    NoMatchingAdapter { filter: String, available: String },
+    #[error("device '{device}' lacks required Vulkan feature(s): {missing}")]
+    MissingFeature { device: String, missing: String },
+    #[error("GPU memory allocation for '{name}' failed: {source}")]
+    Allocation {
+        name: String,
+        #[source]
+        source: gpu_allocator::AllocationError,
+    },
+    #[error("invalid request: {0}")]
+    Invalid(String),
+}
+
+/// Attaches the name of the Vulkan call to a `VkResult`, and turns device loss into its own error.
+pub(crate) trait VkResultExt<T> {
+    fn vk(self, call: &'static str) -> Result<T, GpuError>;
+}
+
+impl<T> VkResultExt<T> for Result<T, vk::Result> {
+    fn vk(self, call: &'static str) -> Result<T, GpuError> {
+        self.map_err(|result| match result {
+            vk::Result::ERROR_DEVICE_LOST => GpuError::DeviceLost { call },
+            result => GpuError::Vk { call, result },
+        })
+    }
+}

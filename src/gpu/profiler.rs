@@ -1,0 +1,135 @@
+//! GPU timestamps: a query pool of named begin/end pairs, reset from the host, read after the submission's
+//! completion, masked to `timestampValidBits` and scaled by `timestampPeriod` (as Granite's query pool does).
+//! Each scope is also a debug label, so captures show the same names.
+
+use ash::vk;
+
+use super::{Context, GpuError, Recorder, VkResultExt};
+
+/// The GPU time of one named scope.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ScopeTiming {
+    pub name: String,
+    pub ms: f64,
+}
+
+pub struct Profiler {
+    pool: vk::QueryPool,
+    capacity: u32,
+    names: Vec<String>,
+    period_ns: f64,
+    valid_mask: u64,
+}
+
+/// An open scope; close it with [`Profiler::end`].
+#[must_use]
+pub struct Scope(u32);
+
+impl Profiler {
+    /// A profiler that holds up to `max_scopes` scopes between resets.
+    pub fn new(ctx: &Context, max_scopes: u32, name: &str) -> Result<Self, GpuError> {
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(max_scopes * 2);
+        // SAFETY: valid create info; destroyed through the deletion queue.
+        let pool = unsafe { ctx.device.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+        ctx.set_name(pool, name);
+        let bits = ctx.timestamp_valid_bits;
+        let mut profiler = Self {
+            pool,
+            capacity: max_scopes,
+            names: Vec::new(),
+            period_ns: ctx.properties.limits.timestamp_period as f64,
+            valid_mask: if bits >= 64 {
+                u64::MAX
+            } else {
+                (1u64 << bits) - 1
+            },
+        };
+        profiler.reset(ctx);
+        Ok(profiler)
+    }
+
+    /// Clears all scopes (host query reset). Only after the previous results were read or abandoned.
+    pub fn reset(&mut self, ctx: &Context) {
+        // SAFETY: hostQueryReset is a required feature; no pending submission uses these queries (caller's contract).
+        unsafe { ctx.device.reset_query_pool(self.pool, 0, self.capacity * 2) };
+        self.names.clear();
+    }
+
+    /// Writes the begin timestamp of scope `name` and opens a debug label.
+    pub fn begin(&mut self, rec: &mut Recorder, name: &str) -> Result<Scope, GpuError> {
+        let index = self.names.len() as u32;
+        if index >= self.capacity {
+            return Err(GpuError::Invalid(format!(
+                "profiler full ({} scopes); cannot open '{name}'",
+                self.capacity
+            )));
+        }
+        self.names.push(name.to_string());
+        let ctx = rec.ctx();
+        ctx.begin_label(rec.cmd, name);
+        // SAFETY: query index within the pool, reset since last use.
+        unsafe {
+            ctx.device.cmd_write_timestamp2(
+                rec.cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.pool,
+                index * 2,
+            )
+        };
+        Ok(Scope(index))
+    }
+
+    /// Writes the end timestamp of `scope` and closes its label.
+    pub fn end(&mut self, rec: &mut Recorder, scope: Scope) {
+        let ctx = rec.ctx();
+        // SAFETY: as in begin.
+        unsafe {
+            ctx.device.cmd_write_timestamp2(
+                rec.cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.pool,
+                scope.0 * 2 + 1,
+            )
+        };
+        ctx.end_label(rec.cmd);
+    }
+
+    /// Reads every scope written since the last reset. Call after the submission completed.
+    pub fn read(&self, ctx: &Context) -> Result<Vec<ScopeTiming>, GpuError> {
+        let count = self.names.len() as u32 * 2;
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        let mut raw = vec![0u64; count as usize];
+        // SAFETY: the queries were written by a completed submission; WAIT makes this robust anyway.
+        unsafe {
+            ctx.device.get_query_pool_results(
+                self.pool,
+                0,
+                &mut raw,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .vk("vkGetQueryPoolResults")?;
+        Ok(self
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let begin = raw[2 * i] & self.valid_mask;
+                let end = raw[2 * i + 1] & self.valid_mask;
+                let ticks = end.wrapping_sub(begin) & self.valid_mask;
+                ScopeTiming {
+                    name: name.clone(),
+                    ms: ticks as f64 * self.period_ns * 1e-6,
+                }
+            })
+            .collect())
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        ctx.retire_query_pool(self.pool);
+    }
+}

@@ -1,0 +1,383 @@
+//! Command recording and submission. Every submission signals the next value of one timeline semaphore, which
+//! orders deferred deletion and lets callers wait for exactly the work they need (never `vkDeviceWaitIdle` per
+//! upload). Uploads go through one path: a staging buffer, a copy, a barrier.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use ash::vk;
+
+use super::{Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, VkResultExt};
+
+/// The timeline semaphore that every submission signals.
+pub(crate) struct Timeline {
+    semaphore: vk::Semaphore,
+    last: AtomicU64,
+}
+
+impl Timeline {
+    pub(crate) fn new(device: &ash::Device) -> Result<Self, GpuError> {
+        let mut kind = vk::SemaphoreTypeCreateInfo::default()
+            .semaphore_type(vk::SemaphoreType::TIMELINE)
+            .initial_value(0);
+        let info = vk::SemaphoreCreateInfo::default().push_next(&mut kind);
+        // SAFETY: valid create info.
+        let semaphore = unsafe { device.create_semaphore(&info, None) }.vk("vkCreateSemaphore")?;
+        Ok(Self {
+            semaphore,
+            last: AtomicU64::new(0),
+        })
+    }
+
+    pub(crate) fn last_submitted(&self) -> u64 {
+        self.last.load(Ordering::Acquire)
+    }
+
+    pub(crate) fn completed(&self, device: &ash::Device) -> Result<u64, GpuError> {
+        // SAFETY: the semaphore belongs to this device.
+        unsafe { device.get_semaphore_counter_value(self.semaphore) }
+            .vk("vkGetSemaphoreCounterValue")
+    }
+
+    pub(crate) fn destroy(&self, device: &ash::Device) {
+        // SAFETY: called at shutdown after the device is idle.
+        unsafe { device.destroy_semaphore(self.semaphore, None) };
+    }
+}
+
+/// Identifies one submission; wait for it with [`Context::wait`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct SubmissionId(pub u64);
+
+/// A command buffer being recorded, with the staging buffers its uploads use.
+pub struct Recorder<'a> {
+    ctx: &'a Context,
+    pool: vk::CommandPool,
+    pub cmd: vk::CommandBuffer,
+    staging: Vec<Buffer>,
+}
+
+impl<'a> Recorder<'a> {
+    /// Starts recording a one-time command buffer named `name`.
+    pub fn begin(ctx: &'a Context, name: &str) -> Result<Self, GpuError> {
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        // SAFETY: valid create info; the pool is retired after the submission.
+        let pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
+            .vk("vkCreateCommandPool")?;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let cmd = match unsafe { ctx.device.allocate_command_buffers(&alloc) } {
+            Ok(c) => c[0],
+            Err(e) => {
+                unsafe { ctx.device.destroy_command_pool(pool, None) };
+                return Err(GpuError::Vk {
+                    call: "vkAllocateCommandBuffers",
+                    result: e,
+                });
+            }
+        };
+        ctx.set_name(cmd, name);
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        unsafe { ctx.device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
+        Ok(Self {
+            ctx,
+            pool,
+            cmd,
+            staging: Vec::new(),
+        })
+    }
+
+    pub fn ctx(&self) -> &'a Context {
+        self.ctx
+    }
+
+    fn stage(&mut self, name: &str, data: &[u8]) -> Result<vk::Buffer, GpuError> {
+        let mut staging = self.ctx.create_buffer(&BufferDesc {
+            name: &format!("staging for {name}"),
+            size: data.len() as u64,
+            usage: vk::BufferUsageFlags::TRANSFER_SRC,
+            location: MemoryLocation::CpuToGpu,
+        })?;
+        staging.write(0, data)?;
+        let raw = staging.raw;
+        self.staging.push(staging);
+        Ok(raw)
+    }
+
+    /// Copies `data` into `dst` at `offset` through a staging buffer, then makes it visible to shaders.
+    pub fn upload_buffer(
+        &mut self,
+        dst: &Buffer,
+        offset: u64,
+        data: &[u8],
+    ) -> Result<(), GpuError> {
+        if data.is_empty() {
+            return Ok(());
+        }
+        if offset + data.len() as u64 > dst.size {
+            return Err(GpuError::Invalid(format!(
+                "upload of {} bytes at {offset} overflows buffer '{}' of {} bytes",
+                data.len(),
+                dst.name,
+                dst.size
+            )));
+        }
+        let src = self.stage(&dst.name, data)?;
+        let region = vk::BufferCopy::default()
+            .dst_offset(offset)
+            .size(data.len() as u64);
+        // SAFETY: both buffers are alive until the submission completes (staging is retired after it).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer(self.cmd, src, dst.raw, &[region])
+        };
+        self.buffer_barrier(
+            dst,
+            vk::PipelineStageFlags2::TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_STORAGE_READ,
+        );
+        Ok(())
+    }
+
+    /// Copies tightly packed texels into array layer `layer` of `dst` through a staging buffer. The image must be in
+    /// TRANSFER_DST_OPTIMAL.
+    pub fn upload_image_layer(
+        &mut self,
+        dst: &Image,
+        layer: u32,
+        data: &[u8],
+    ) -> Result<(), GpuError> {
+        let src = self.stage(&dst.name, data)?;
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .base_array_layer(layer)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: dst.extent.width,
+                height: dst.extent.height,
+                depth: 1,
+            });
+        // SAFETY: the image is in TRANSFER_DST_OPTIMAL (caller's contract) and alive until completion.
+        unsafe {
+            self.ctx.device.cmd_copy_buffer_to_image(
+                self.cmd,
+                src,
+                dst.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+
+    /// Copies the whole of `src` (in TRANSFER_SRC_OPTIMAL) into `dst`, layer after layer, tightly packed.
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        let region = vk::BufferImageCopy::default()
+            .buffer_offset(offset)
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .layer_count(src.layers),
+            )
+            .image_extent(vk::Extent3D {
+                width: src.extent.width,
+                height: src.extent.height,
+                depth: 1,
+            });
+        // SAFETY: layouts are the caller's contract; both objects outlive the submission.
+        unsafe {
+            self.ctx.device.cmd_copy_image_to_buffer(
+                self.cmd,
+                src.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.raw,
+                &[region],
+            )
+        };
+    }
+
+    /// Copies the first `size` bytes of `src` to `dst`, then makes them visible to the host.
+    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size: u64) {
+        let region = vk::BufferCopy::default().size(size);
+        // SAFETY: both buffers outlive the submission.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region])
+        };
+        self.buffer_barrier(
+            dst,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+    }
+
+    pub fn buffer_barrier(
+        &mut self,
+        buffer: &Buffer,
+        src_stage: vk::PipelineStageFlags2,
+        src_access: vk::AccessFlags2,
+        dst_stage: vk::PipelineStageFlags2,
+        dst_access: vk::AccessFlags2,
+    ) {
+        let barrier = [vk::BufferMemoryBarrier2::default()
+            .buffer(buffer.raw)
+            .size(vk::WHOLE_SIZE)
+            .src_stage_mask(src_stage)
+            .src_access_mask(src_access)
+            .dst_stage_mask(dst_stage)
+            .dst_access_mask(dst_access)];
+        let dep = vk::DependencyInfo::default().buffer_memory_barriers(&barrier);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// A global memory barrier (cheaper to write than per-resource barriers when many patches are involved).
+    pub fn memory_barrier(
+        &mut self,
+        src_stage: vk::PipelineStageFlags2,
+        src_access: vk::AccessFlags2,
+        dst_stage: vk::PipelineStageFlags2,
+        dst_access: vk::AccessFlags2,
+    ) {
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(src_stage)
+            .src_access_mask(src_access)
+            .dst_stage_mask(dst_stage)
+            .dst_access_mask(dst_access)];
+        let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// Transitions every subresource of each image from `old` to `new` layout, with full stage/access masks on
+    /// both sides of the given stages.
+    #[allow(clippy::too_many_arguments)]
+    pub fn image_transitions(
+        &mut self,
+        images: &[&Image],
+        old: vk::ImageLayout,
+        new: vk::ImageLayout,
+        src_stage: vk::PipelineStageFlags2,
+        src_access: vk::AccessFlags2,
+        dst_stage: vk::PipelineStageFlags2,
+        dst_access: vk::AccessFlags2,
+    ) {
+        let barriers: Vec<_> = images
+            .iter()
+            .map(|image| {
+                vk::ImageMemoryBarrier2::default()
+                    .image(image.raw)
+                    .subresource_range(image.range())
+                    .old_layout(old)
+                    .new_layout(new)
+                    .src_stage_mask(src_stage)
+                    .src_access_mask(src_access)
+                    .dst_stage_mask(dst_stage)
+                    .dst_access_mask(dst_access)
+            })
+            .collect();
+        if barriers.is_empty() {
+            return;
+        }
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// Ends recording and submits; `waits`/`signals` are binary semaphores (swapchain acquire/present).
+    pub fn submit_with(
+        self,
+        waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+        signals: &[vk::Semaphore],
+    ) -> Result<SubmissionId, GpuError> {
+        let ctx = self.ctx;
+        // SAFETY: the command buffer is recording.
+        unsafe { ctx.device.end_command_buffer(self.cmd) }.vk("vkEndCommandBuffer")?;
+        let queue = ctx.queue();
+        let value = ctx.timeline.last_submitted() + 1;
+        let wait_infos: Vec<_> = waits
+            .iter()
+            .map(|&(s, stage)| {
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(s)
+                    .stage_mask(stage)
+            })
+            .collect();
+        let mut signal_infos: Vec<_> = signals
+            .iter()
+            .map(|&s| {
+                vk::SemaphoreSubmitInfo::default()
+                    .semaphore(s)
+                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+            })
+            .collect();
+        signal_infos.push(
+            vk::SemaphoreSubmitInfo::default()
+                .semaphore(ctx.timeline.semaphore)
+                .value(value)
+                .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS),
+        );
+        let cmd_infos = [vk::CommandBufferSubmitInfo::default().command_buffer(self.cmd)];
+        let submit = [vk::SubmitInfo2::default()
+            .wait_semaphore_infos(&wait_infos)
+            .command_buffer_infos(&cmd_infos)
+            .signal_semaphore_infos(&signal_infos)];
+        // SAFETY: queue access is serialised by the lock; all referenced objects live until `value` completes.
+        unsafe { ctx.device.queue_submit2(*queue, &submit, vk::Fence::null()) }
+            .vk("vkQueueSubmit2")?;
+        ctx.timeline
+            .last
+            .store(value, std::sync::atomic::Ordering::Release);
+        drop(queue);
+        ctx.retire_command_pool(self.pool);
+        for staging in self.staging {
+            ctx.retire_buffer(staging);
+        }
+        Ok(SubmissionId(value))
+    }
+
+    pub fn submit(self) -> Result<SubmissionId, GpuError> {
+        self.submit_with(&[], &[])
+    }
+}
+
+impl Context {
+    /// Blocks until `id` has completed on the GPU, then frees what it guarded.
+    pub fn wait(&self, id: SubmissionId) -> Result<(), GpuError> {
+        let semaphores = [self.timeline.semaphore];
+        let values = [id.0];
+        let info = vk::SemaphoreWaitInfo::default()
+            .semaphores(&semaphores)
+            .values(&values);
+        // SAFETY: the semaphore belongs to this device.
+        unsafe { self.device.wait_semaphores(&info, u64::MAX) }.vk("vkWaitSemaphores")?;
+        self.collect_garbage();
+        Ok(())
+    }
+
+    /// Runs `record` in a fresh command buffer, submits it and waits. For tests, tools and set-up, not per frame.
+    pub fn run_and_wait<T>(
+        &self,
+        name: &str,
+        record: impl FnOnce(&mut Recorder) -> Result<T, GpuError>,
+    ) -> Result<T, GpuError> {
+        let mut rec = Recorder::begin(self, name)?;
+        let out = record(&mut rec)?;
+        let id = rec.submit()?;
+        self.wait(id)?;
+        Ok(out)
+    }
+}

@@ -1,0 +1,48 @@
+//! Shared GPU test harness: one device per test binary, validation on, and a canary that fails a test when the
+//! validation layer reported any error. Without a driver a GPU test prints why and skips, unless
+//! `RIVERPLANET_REQUIRE_GPU=1` (tools/test and CI set it), which turns the skip into a failure.
+
+#![allow(dead_code)]
+
+use std::sync::OnceLock;
+
+use riverplanet::gpu::{Context, ContextOptions};
+
+static CONTEXT: OnceLock<Result<Context, String>> = OnceLock::new();
+
+/// The shared context, or `None` (test skipped) when no usable device exists and a GPU is not required.
+pub fn gpu() -> Option<&'static Context> {
+    let result = CONTEXT.get_or_init(|| {
+        let _ = env_logger::builder().is_test(true).try_init();
+        let mut options = ContextOptions::from_env();
+        options.validation = std::env::var("RIVERPLANET_VALIDATION").map_or(true, |v| v != "0");
+        Context::new(&options).map_err(|e| e.to_string())
+    });
+    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
+    match result {
+        Ok(ctx) => {
+            if required {
+                assert!(
+                    ctx.validation_enabled(),
+                    "RIVERPLANET_REQUIRE_GPU=1 but the validation layer is not active (install vulkan-validationlayers)"
+                );
+            }
+            Some(ctx)
+        }
+        Err(e) if required => panic!("RIVERPLANET_REQUIRE_GPU=1 but no usable Vulkan device: {e}"),
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}
+
+/// Fails the calling test if the validation layer reported errors so far (in this binary).
+pub fn assert_no_validation_errors(ctx: &Context) {
+    let errors = ctx.validation_errors();
+    assert!(
+        errors.is_empty(),
+        "validation errors:\n{}",
+        errors.join("\n")
+    );
+}

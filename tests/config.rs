@@ -1,0 +1,156 @@
+//! The XML configuration: Appendix A as printed, and every class of bad input reported by element and range.
+
+use riverplanet::config::{Config, ConfigError};
+
+const APPENDIX_A: &str = include_str!("../config/planet.xml");
+
+fn with(section: &str, element: &str, value: &str) -> String {
+    let open = format!("<{element}>");
+    let close = format!("</{element}>");
+    if let (Some(a), Some(b)) = (APPENDIX_A.find(&open), APPENDIX_A.find(&close)) {
+        format!("{}{open}{value}{}", &APPENDIX_A[..a], &APPENDIX_A[b..])
+    } else {
+        let tag = format!("<{section}>");
+        APPENDIX_A.replacen(&tag, &format!("{tag}\n    {open}{value}{close}"), 1)
+    }
+}
+
+fn error_of(xml: &str) -> String {
+    match Config::parse(xml, "test.xml") {
+        Ok(c) => panic!("accepted invalid configuration: {c:?}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn appendix_a_reads_as_printed() {
+    let c = Config::parse(APPENDIX_A, "config/planet.xml").expect("Appendix A must parse");
+    assert_eq!(c.planet.radius, 1024.0);
+    assert_eq!(c.planet.continents, 5);
+    assert_eq!(c.planet.landmass_percentage, 30.0);
+    assert_eq!(c.planet.sea_level_height, 0.4);
+    assert_eq!(c.planet.max_mountain_height, 16.0);
+    assert_eq!(c.planet.atmosphere_height, 32.0);
+    assert_eq!(c.planet.master_seed, -1);
+    assert!(
+        !c.planet.continents_from_file,
+        "the stray '>' in '>false' is tolerated"
+    );
+    assert_eq!(c.river.influence_distance, 20.0);
+    assert_eq!(c.river.basin_depth, 0.1);
+    assert_eq!(c.river.basin_water_offset, 0.001);
+    assert_eq!(c.river.starting_width, 2.5);
+    assert_eq!(c.river.min_width, 0.075);
+    assert_eq!(c.river.ending_factor, 2.0);
+    assert_eq!(c.river.segments, 5);
+    assert_eq!(c.rendering.vertices, 33);
+    assert_eq!(c.rendering.max_level_of_detail, 6);
+    assert_eq!(c.rendering.level_of_detail_switch_factor, 8.0);
+}
+
+#[test]
+fn the_shipped_file_loads_from_disk() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml");
+    Config::load(&path).unwrap();
+}
+
+#[test]
+fn vertices_must_be_power_of_two_plus_one() {
+    for bad in ["32", "34", "0", "1", "abc", "-33"] {
+        let msg = error_of(&with("rendering-attributes", "vertices", bad));
+        assert!(msg.contains("<vertices>"), "{msg}");
+        assert!(msg.contains(&format!("'{bad}'")), "{msg}");
+        assert!(msg.contains("2^n+1"), "{msg}");
+    }
+    for good in ["17", "33", "65"] {
+        Config::parse(&with("rendering-attributes", "vertices", good), "t").unwrap();
+    }
+}
+
+#[test]
+fn radius_must_be_positive() {
+    for bad in ["0", "-5.0f", "nan", "inf"] {
+        let msg = error_of(&with("planet-attributes", "radius", bad));
+        assert!(msg.contains("<radius>") && msg.contains("> 0"), "{msg}");
+    }
+}
+
+#[test]
+fn widths_must_be_positive() {
+    for element in ["starting-width", "min-width", "influence-distance"] {
+        let msg = error_of(&with("river-attributes", element, "0.0f"));
+        assert!(
+            msg.contains(&format!("<{element}>")) && msg.contains("> 0"),
+            "{msg}"
+        );
+    }
+    let msg = error_of(&with("river-attributes", "min-width", "3.0f"));
+    assert!(msg.contains("must not exceed starting-width"), "{msg}");
+}
+
+#[test]
+fn landmass_must_lie_strictly_between_0_and_100() {
+    for bad in ["0", "100", "-1", "150.0f"] {
+        let msg = error_of(&with("planet-attributes", "landmass-percentage", bad));
+        assert!(
+            msg.contains("<landmass-percentage>") && msg.contains("(0, 100)"),
+            "{msg}"
+        );
+    }
+    Config::parse(
+        &with("planet-attributes", "landmass-percentage", "0.5f"),
+        "t",
+    )
+    .unwrap();
+}
+
+#[test]
+fn unknown_elements_are_rejected_by_name() {
+    let msg = error_of(&with("river-attributes", "river-colour", "blue"));
+    assert!(msg.contains("unknown element `river-colour`"), "{msg}");
+    let msg = error_of(
+        &APPENDIX_A
+            .replace("<river-attributes>", "<rivers-attributes>")
+            .replace("</river-attributes>", "</rivers-attributes>"),
+    );
+    assert!(msg.contains("rivers-attributes"), "{msg}");
+}
+
+#[test]
+fn malformed_xml_is_an_error_not_a_panic() {
+    for bad in [
+        "",
+        "not xml at all",
+        "<planet><planet-attributes><radius>1</planet-attributes></planet>",
+        &APPENDIX_A[..APPENDIX_A.len() / 2],
+    ] {
+        let err = Config::parse(bad, "broken.xml").unwrap_err();
+        assert!(matches!(err, ConfigError::Xml { .. }), "{err}");
+        assert!(err.to_string().contains("broken.xml"), "{err}");
+    }
+}
+
+#[test]
+fn unreadable_file_names_the_path() {
+    let err = Config::load(std::path::Path::new("/nonexistent/planet.xml")).unwrap_err();
+    assert!(err.to_string().contains("/nonexistent/planet.xml"), "{err}");
+}
+
+#[test]
+fn missing_elements_take_defaults() {
+    let c = Config::parse(
+        "<planet><planet-attributes><radius>10</radius></planet-attributes></planet>",
+        "t",
+    )
+    .unwrap();
+    assert_eq!(c.planet.radius, 10.0);
+    assert_eq!(c.rendering.vertices, 33);
+}
+
+#[test]
+fn seed_accepts_minus_one_and_rejects_below() {
+    let msg = error_of(&with("planet-attributes", "master-seed", "-2"));
+    assert!(msg.contains("<master-seed>"), "{msg}");
+    let c = Config::parse(&with("planet-attributes", "master-seed", "42"), "t").unwrap();
+    assert_eq!(c.resolve_seed(), 42);
+}

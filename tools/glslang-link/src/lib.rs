@@ -1,0 +1,1 @@
+//! Carries link directives only; see build.rs.
