@@ -7,6 +7,7 @@
 pub mod config;
 pub mod gpu;
 pub mod kernel;
+pub mod rng;
 
 /// SPIR-V of every shader in `glsl/`, compiled by build.rs.
 pub mod shaders {

@@ -4,7 +4,7 @@ mod common;
 
 use riverplanet::{
     gpu::{
-        pipeline::{BufferSets, ComputePipeline},
+        pipeline::{BufferSetLayout, ComputePipeline},
         vk, BufferDesc, MemoryLocation, Profiler,
     },
     shaders,
@@ -31,14 +31,14 @@ fn compute_dispatch_reads_back_and_is_timed() {
             location: MemoryLocation::GpuToCpu,
         })
         .unwrap();
-    let sets = BufferSets::new(ctx, 1, 1, "fill set").unwrap();
-    let set = sets.allocate(ctx, &[&out]).unwrap();
+    let sets = BufferSetLayout::new(ctx, 1, "fill set").unwrap();
     let pipeline =
         ComputePipeline::new(ctx, shaders::FILL_COMP, "fill", &[sets.layout], 12, &[]).unwrap();
     let mut profiler = Profiler::new(ctx, 4, "fill timestamps").unwrap();
 
     let push: [u32; 3] = [0.5f32.to_bits(), 3.0f32.to_bits(), COUNT];
     ctx.run_and_wait("fill", |rec| {
+        let set = rec.buffer_set(&sets, &[&out])?;
         let scope = profiler.begin(rec, "fill kernel")?;
         rec.dispatch(
             &pipeline,

@@ -227,10 +227,7 @@ type Enumeration = (Vec<AdapterInfo>, Vec<vk::PhysicalDevice>, Option<usize>);
 
 /// Lists every device and marks the one `options` chooses: the adapter filter first, then discrete GPUs before
 /// integrated, virtual and CPU devices, among devices with every required feature.
-fn choose(
-    instance: &ash::Instance,
-    options: &ContextOptions,
-) -> Result<Enumeration, GpuError> {
+fn choose(instance: &ash::Instance, options: &ContextOptions) -> Result<Enumeration, GpuError> {
     // SAFETY: plain query.
     let physicals =
         unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;

@@ -72,6 +72,8 @@ pub struct ImageDesc<'a> {
     pub format: vk::Format,
     pub usage: vk::ImageUsageFlags,
     pub aspect: vk::ImageAspectFlags,
+    /// View it as a 2D array even with one layer (so shaders can index every patch texture alike).
+    pub array: bool,
 }
 
 pub struct Image {
@@ -103,6 +105,7 @@ enum Retired {
     Buffer(vk::Buffer, Option<Allocation>),
     Image(vk::Image, vk::ImageView, Option<Allocation>),
     Pool(vk::CommandPool),
+    DescriptorPool(vk::DescriptorPool),
     QueryPool(vk::QueryPool),
 }
 
@@ -151,6 +154,7 @@ impl DeletionQueue {
                         }
                     }
                     Retired::Pool(p) => device.destroy_command_pool(p, None),
+                    Retired::DescriptorPool(p) => device.destroy_descriptor_pool(p, None),
                     Retired::QueryPool(q) => device.destroy_query_pool(q, None),
                 }
             }
@@ -247,7 +251,7 @@ impl Context {
                 .bind_image_memory(raw, allocation.memory(), allocation.offset())
         }
         .vk("vkBindImageMemory")?;
-        let view_type = if desc.layers > 1 {
+        let view_type = if desc.layers > 1 || desc.array {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
             vk::ImageViewType::TYPE_2D
@@ -296,6 +300,13 @@ impl Context {
     pub(crate) fn retire_command_pool(&self, pool: vk::CommandPool) {
         self.deletion
             .push(self.timeline.last_submitted(), Retired::Pool(pool));
+    }
+
+    pub(crate) fn retire_descriptor_pool(&self, pool: vk::DescriptorPool) {
+        self.deletion.push(
+            self.timeline.last_submitted(),
+            Retired::DescriptorPool(pool),
+        );
     }
 
     pub(crate) fn retire_query_pool(&self, pool: vk::QueryPool) {

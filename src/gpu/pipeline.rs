@@ -2,7 +2,7 @@
 
 use ash::vk;
 
-use super::{Buffer, Context, GpuError, Recorder, VkResultExt};
+use super::{Context, GpuError, Recorder, VkResultExt};
 
 /// Creates a shader module from SPIR-V bytes produced by build.rs.
 pub fn shader_module(
@@ -20,16 +20,15 @@ pub fn shader_module(
     Ok(module)
 }
 
-/// A descriptor set layout of `count` storage buffers at bindings 0..count, and a pool to allocate sets from.
-/// Used for per-dispatch inputs (samples, range table); reset the pool once the dispatches completed.
-pub struct BufferSets {
+/// A descriptor set layout of `count` storage buffers at bindings 0..count, for per-dispatch inputs (samples,
+/// range table). Sets are allocated per recording with [`Recorder::buffer_set`].
+pub struct BufferSetLayout {
     pub layout: vk::DescriptorSetLayout,
-    pool: vk::DescriptorPool,
-    count: u32,
+    pub count: u32,
 }
 
-impl BufferSets {
-    pub fn new(ctx: &Context, count: u32, max_sets: u32, name: &str) -> Result<Self, GpuError> {
+impl BufferSetLayout {
+    pub fn new(ctx: &Context, count: u32, name: &str) -> Result<Self, GpuError> {
         let bindings: Vec<_> = (0..count)
             .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
@@ -44,81 +43,12 @@ impl BufferSets {
         let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
             .vk("vkCreateDescriptorSetLayout")?;
         ctx.set_name(layout, name);
-        let sizes = [vk::DescriptorPoolSize {
-            ty: vk::DescriptorType::STORAGE_BUFFER,
-            descriptor_count: count * max_sets,
-        }];
-        let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(max_sets)
-            .pool_sizes(&sizes);
-        let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
-            .vk("vkCreateDescriptorPool")?;
-        Ok(Self {
-            layout,
-            pool,
-            count,
-        })
-    }
-
-    /// Allocates a set pointing at `buffers` (one per binding, whole range).
-    pub fn allocate(
-        &self,
-        ctx: &Context,
-        buffers: &[&Buffer],
-    ) -> Result<vk::DescriptorSet, GpuError> {
-        if buffers.len() as u32 != self.count {
-            return Err(GpuError::Invalid(format!(
-                "descriptor set wants {} buffers, got {}",
-                self.count,
-                buffers.len()
-            )));
-        }
-        let layouts = [self.layout];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(self.pool)
-            .set_layouts(&layouts);
-        // SAFETY: valid allocate info.
-        let set = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
-            .vk("vkAllocateDescriptorSets")?[0];
-        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
-            .iter()
-            .map(|b| {
-                [vk::DescriptorBufferInfo::default()
-                    .buffer(b.raw)
-                    .range(vk::WHOLE_SIZE)]
-            })
-            .collect();
-        let writes: Vec<_> = infos
-            .iter()
-            .enumerate()
-            .map(|(i, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .buffer_info(info)
-            })
-            .collect();
-        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
-        Ok(set)
-    }
-
-    /// Frees every set of the pool. Only when no pending submission uses them.
-    pub fn reset(&self, ctx: &Context) -> Result<(), GpuError> {
-        // SAFETY: caller's contract above.
-        unsafe {
-            ctx.device
-                .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
-        }
-        .vk("vkResetDescriptorPool")
+        Ok(Self { layout, count })
     }
 
     pub fn destroy(self, ctx: &Context) {
-        // SAFETY: called after all work using these sets completed.
-        unsafe {
-            ctx.device.destroy_descriptor_pool(self.pool, None);
-            ctx.device.destroy_descriptor_set_layout(self.layout, None);
-        }
+        // SAFETY: called after all work using the layout completed.
+        unsafe { ctx.device.destroy_descriptor_set_layout(self.layout, None) };
     }
 }
 

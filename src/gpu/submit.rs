@@ -53,8 +53,14 @@ pub struct Recorder<'a> {
     ctx: &'a Context,
     pool: vk::CommandPool,
     pub cmd: vk::CommandBuffer,
-    staging: Vec<Buffer>,
+    /// Buffers this recording uses and frees once its submission completed (staging, per-dispatch inputs).
+    owned: Vec<Buffer>,
+    /// Transient pool for per-dispatch descriptor sets, retired with the submission.
+    descriptor_pool: Option<vk::DescriptorPool>,
 }
+
+/// Per-dispatch descriptor sets one recording can allocate.
+const TRANSIENT_SETS: u32 = 64;
 
 impl<'a> Recorder<'a> {
     /// Starts recording a one-time command buffer named `name`.
@@ -87,7 +93,8 @@ impl<'a> Recorder<'a> {
             ctx,
             pool,
             cmd,
-            staging: Vec::new(),
+            owned: Vec::new(),
+            descriptor_pool: None,
         })
     }
 
@@ -104,8 +111,76 @@ impl<'a> Recorder<'a> {
         })?;
         staging.write(0, data)?;
         let raw = staging.raw;
-        self.staging.push(staging);
+        self.owned.push(staging);
         Ok(raw)
+    }
+
+    /// Keeps `buffer` alive until this recording's submission has completed, then frees it.
+    pub fn free_after_completion(&mut self, buffer: Buffer) {
+        self.owned.push(buffer);
+    }
+
+    /// A descriptor set of `layout` pointing at `buffers` (binding i = buffers[i], whole range), valid for this
+    /// recording only.
+    pub fn buffer_set(
+        &mut self,
+        layout: &super::pipeline::BufferSetLayout,
+        buffers: &[&Buffer],
+    ) -> Result<vk::DescriptorSet, GpuError> {
+        if buffers.len() as u32 != layout.count {
+            return Err(GpuError::Invalid(format!(
+                "descriptor set wants {} buffers, got {}",
+                layout.count,
+                buffers.len()
+            )));
+        }
+        let device = &self.ctx.device;
+        let pool = match self.descriptor_pool {
+            Some(p) => p,
+            None => {
+                let sizes = [vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::STORAGE_BUFFER,
+                    descriptor_count: TRANSIENT_SETS * 4,
+                }];
+                let info = vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(TRANSIENT_SETS)
+                    .pool_sizes(&sizes);
+                // SAFETY: valid create info; retired with the submission.
+                let p = unsafe { device.create_descriptor_pool(&info, None) }
+                    .vk("vkCreateDescriptorPool")?;
+                self.descriptor_pool = Some(p);
+                p
+            }
+        };
+        let layouts = [layout.layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(pool)
+            .set_layouts(&layouts);
+        // SAFETY: valid allocate info.
+        let set =
+            unsafe { device.allocate_descriptor_sets(&alloc) }.vk("vkAllocateDescriptorSets")?[0];
+        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+            .iter()
+            .map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(b.raw)
+                    .range(vk::WHOLE_SIZE)]
+            })
+            .collect();
+        let writes: Vec<_> = infos
+            .iter()
+            .enumerate()
+            .map(|(i, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .buffer_info(info)
+            })
+            .collect();
+        // SAFETY: the set is fresh and unused.
+        unsafe { device.update_descriptor_sets(&writes, &[]) };
+        Ok(set)
     }
 
     /// Copies `data` into `dst` at `offset` through a staging buffer, then makes it visible to shaders.
@@ -180,8 +255,15 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
-    /// Copies the whole of `src` (in TRANSFER_SRC_OPTIMAL) into `dst`, layer after layer, tightly packed.
-    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+    /// Copies the whole of `src` (in `layout`: GENERAL or TRANSFER_SRC_OPTIMAL) into `dst` at `offset`, layer after
+    /// layer, tightly packed.
+    pub fn copy_image_to_buffer(
+        &mut self,
+        src: &Image,
+        layout: vk::ImageLayout,
+        dst: &Buffer,
+        offset: u64,
+    ) {
         let region = vk::BufferImageCopy::default()
             .buffer_offset(offset)
             .image_subresource(
@@ -196,13 +278,9 @@ impl<'a> Recorder<'a> {
             });
         // SAFETY: layouts are the caller's contract; both objects outlive the submission.
         unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(
-                self.cmd,
-                src.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                dst.raw,
-                &[region],
-            )
+            self.ctx
+                .device
+                .cmd_copy_image_to_buffer(self.cmd, src.raw, layout, dst.raw, &[region])
         };
     }
 
@@ -343,8 +421,11 @@ impl<'a> Recorder<'a> {
             .store(value, std::sync::atomic::Ordering::Release);
         drop(queue);
         ctx.retire_command_pool(self.pool);
-        for staging in self.staging {
-            ctx.retire_buffer(staging);
+        if let Some(pool) = self.descriptor_pool {
+            ctx.retire_descriptor_pool(pool);
+        }
+        for buffer in self.owned {
+            ctx.retire_buffer(buffer);
         }
         Ok(SubmissionId(value))
     }

@@ -1,1 +1,81 @@
-//! The river-height kernel of Sections 6.5-6.6 and Chapter 7.
+//! The river-height kernel of Sections 6.5-6.6 (Procedures 3-5) and Chapter 7: for every vertex of a patch, a
+//! weighted sum over the river samples that influence the patch.
+//!
+//! [`cpu`] is the reference (single-threaded, as the thesis's baseline, and a rayon version); [`gpu`] dispatches
+//! the same kernel body (`glsl/river_kernel.glsl`) as the simple (7.3.1) or the tiled (7.3.2) compute shader.
+//!
+//! Coordinates: a patch's vertex (i, j) sits at `(i, j) * spacing` in the patch's own 2D frame, and its samples are
+//! given in that frame too (relative to the patch corner), which keeps f32 precise at any depth of the quadtree.
+
+pub mod cpu;
+pub mod gpu;
+pub mod workload;
+
+use bytemuck::{Pod, Zeroable};
+
+/// One river sample (6.4): position and first derivative in the patch frame, river height and full width.
+/// Two vec4s in std430 (32 bytes), which lets the shaders load it with two aligned 16-byte reads.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RiverSample {
+    pub position: [f32; 2],
+    pub derivative: [f32; 2],
+    pub height: f32,
+    pub width: f32,
+    pub _pad: [f32; 2],
+}
+
+impl RiverSample {
+    pub fn new(position: [f32; 2], derivative: [f32; 2], height: f32, width: f32) -> Self {
+        Self {
+            position,
+            derivative,
+            height,
+            width,
+            _pad: [0.0; 2],
+        }
+    }
+}
+
+/// The constants of Procedures 3-5, from the configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KernelParams {
+    pub influence_distance: f32,
+    pub basin_depth: f32,
+    pub sea_level: f32,
+    pub basin_water_offset: f32,
+}
+
+impl KernelParams {
+    pub fn from_config(config: &crate::config::Config) -> Self {
+        Self {
+            influence_distance: config.river.influence_distance,
+            basin_depth: config.river.basin_depth,
+            sea_level: config.planet.sea_level_height,
+            basin_water_offset: config.river.basin_water_offset,
+        }
+    }
+}
+
+/// The five per-vertex outputs of Procedure 5. `river_width` is the weighted *half* width, as the procedure
+/// accumulates it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RiverTexel {
+    pub terrain_height: f32,
+    pub lerp_factor: f32,
+    pub water_height: f32,
+    pub min_distance: f32,
+    pub river_width: f32,
+}
+
+/// The work for one patch: the grid spacing and the samples that influence it.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchJob<'a> {
+    pub spacing: f32,
+    pub samples: &'a [RiverSample],
+}
+
+/// Vertex (i, j) of a patch, in the patch frame.
+pub fn vertex_position(i: u32, j: u32, spacing: f32) -> [f32; 2] {
+    [i as f32 * spacing, j as f32 * spacing]
+}

@@ -1,0 +1,225 @@
+//! The CPU reference of Procedures 3-5 (Section 6.5-6.6), line by line, plus a rayon version over patches and rows.
+//!
+//! Where the printed procedures leave a value undefined, the choices (docs/kernel.md) are:
+//! - no relevant sample (`weightSum` = 0): the vertex keeps the base terrain: lerp factor 1, terrain height 0,
+//!   water at sea level, minimum distance = influence distance, river width 0;
+//! - the in-basin test is strict on the projection distance (a vertex exactly on the basin's end has river weight
+//!   0 and would make `inRiverSum / inRiverWSum` 0/0), so `inRiverWSum` > 0 whenever `inRiver`;
+//! - `influenceDistance - riverWidth` <= 0 (a river wider than its influence): lerp factor 0;
+//! - the lerp factor is clamped to [0, 1] (a vertex beyond the river's ends but closer than its width would
+//!   otherwise get a negative factor).
+
+use rayon::prelude::*;
+
+use super::{vertex_position, KernelParams, PatchJob, RiverSample, RiverTexel};
+
+/// What Procedure 3 returns for a relevant sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleContribution {
+    pub height: f32,
+    pub w_dist: f32,
+    pub basin_depth: f32,
+    pub river_width: f32,
+    pub in_river: bool,
+    pub in_river_depth: f32,
+    pub w_river: f32,
+    /// Distance to the sample, negated when the vertex lies left of the sample's direction.
+    pub dist: f32,
+}
+
+fn length(x: f32, y: f32) -> f32 {
+    (x * x + y * y).sqrt()
+}
+
+/// Procedure 3, Section 6.5: one vertex against one sample; `None` when the sample is not relevant.
+pub fn calculate_height_by_sample(
+    v: [f32; 2],
+    sample: &RiverSample,
+    params: &KernelParams,
+) -> Option<SampleContribution> {
+    let p = sample.position;
+    let d = sample.derivative;
+    let dist = length(v[0] - p[0], v[1] - p[1]);
+    if dist > params.influence_distance {
+        return None;
+    }
+    let half_width = sample.width * 0.5;
+    // n(t) = (p'.y, -p'.x); v projected onto the line through p along n.
+    let n = [d[1], -d[0]];
+    let nn = n[0] * n[0] + n[1] * n[1];
+    let s = if nn > 0.0 {
+        ((v[0] - p[0]) * n[0] + (v[1] - p[1]) * n[1]) / nn
+    } else {
+        0.0
+    };
+    let vn = [p[0] + s * n[0], p[1] + s * n[1]];
+    let projection_distance = length(vn[0] - v[0], vn[1] - v[1]);
+    let normal_distance = length(p[0] - vn[0], p[1] - vn[1]);
+    let w_dist = 1.0 - dist / params.influence_distance;
+    let mut c = SampleContribution {
+        height: w_dist * sample.height,
+        w_dist,
+        basin_depth: w_dist * params.basin_depth,
+        river_width: w_dist * half_width,
+        in_river: false,
+        in_river_depth: 0.0,
+        w_river: 0.0,
+        dist,
+    };
+    if projection_distance < half_width && normal_distance <= half_width {
+        let normal_factor = normal_distance / half_width;
+        let factor = normal_factor * normal_factor * normal_factor;
+        c.in_river = true;
+        c.w_river = 1.0 - projection_distance / half_width;
+        c.in_river_depth = c.w_river * factor * c.basin_depth;
+    }
+    // Side of the line p -> p + p' (2D cross product); left of the flow direction is negative.
+    let side = d[0] * (v[1] - p[1]) - d[1] * (v[0] - p[0]);
+    if side > 0.0 {
+        c.dist = -dist;
+    }
+    Some(c)
+}
+
+/// The accumulators of Procedure 4.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Accumulators {
+    pub height_sum: f32,
+    pub weight_sum: f32,
+    pub basin_sum: f32,
+    pub width_sum: f32,
+    pub in_river: bool,
+    pub in_river_sum: f32,
+    pub in_river_w_sum: f32,
+    pub min_distance: f32,
+}
+
+/// Procedure 4, Section 6.5: accumulate the weighted contributions of every relevant sample.
+pub fn accumulate_height(
+    v: [f32; 2],
+    samples: &[RiverSample],
+    params: &KernelParams,
+) -> Accumulators {
+    let mut acc = Accumulators {
+        height_sum: 0.0,
+        weight_sum: 0.0,
+        basin_sum: 0.0,
+        width_sum: 0.0,
+        in_river: false,
+        in_river_sum: 0.0,
+        in_river_w_sum: 0.0,
+        min_distance: f32::MAX,
+    };
+    for sample in samples {
+        let Some(c) = calculate_height_by_sample(v, sample, params) else {
+            continue;
+        };
+        acc.height_sum += c.height;
+        acc.weight_sum += c.w_dist;
+        acc.basin_sum += c.basin_depth;
+        acc.width_sum += c.river_width;
+        if c.in_river {
+            acc.in_river = true;
+            acc.in_river_sum += c.in_river_depth;
+            acc.in_river_w_sum += c.w_river;
+        }
+        if c.dist.abs() < acc.min_distance.abs() {
+            acc.min_distance = c.dist;
+        }
+    }
+    acc
+}
+
+/// Procedure 5, Section 6.6: the final terrain height, lerp factor, water height, signed minimum distance and
+/// river (half) width of one vertex.
+pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelParams) -> RiverTexel {
+    let acc = accumulate_height(v, samples, params);
+    if acc.weight_sum <= 0.0 {
+        return RiverTexel {
+            terrain_height: 0.0,
+            lerp_factor: 1.0,
+            water_height: params.sea_level,
+            min_distance: params.influence_distance,
+            river_width: 0.0,
+        };
+    }
+    let height = acc.height_sum / acc.weight_sum;
+    let basin = acc.basin_sum / acc.weight_sum;
+    let river_width = acc.width_sum / acc.weight_sum;
+    let (terrain_height, lerp_factor, water_height) = if acc.in_river {
+        let in_river_basin = acc.in_river_sum / acc.in_river_w_sum;
+        let height_offset = basin - params.basin_water_offset;
+        (
+            height + in_river_basin,
+            0.0,
+            params.sea_level.max(height + height_offset),
+        )
+    } else {
+        let terrain_height = height + basin;
+        let divisor = params.influence_distance - river_width;
+        let lerp = if divisor > 0.0 {
+            ((acc.min_distance.abs() - river_width) / divisor).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (
+            terrain_height,
+            lerp,
+            params
+                .sea_level
+                .max(terrain_height - params.basin_water_offset),
+        )
+    };
+    RiverTexel {
+        terrain_height,
+        lerp_factor,
+        water_height,
+        min_distance: acc.min_distance,
+        river_width,
+    }
+}
+
+/// One patch, single-threaded: `n x n` texels in row-major order (index `j * n + i`).
+pub fn compute_patch(job: &PatchJob, n: u32, params: &KernelParams) -> Vec<RiverTexel> {
+    (0..n * n)
+        .map(|k| {
+            calculate_height(
+                vertex_position(k % n, k / n, job.spacing),
+                job.samples,
+                params,
+            )
+        })
+        .collect()
+}
+
+/// All patches on one thread: the thesis's CPU baseline (9.2).
+pub fn compute_patches(jobs: &[PatchJob], n: u32, params: &KernelParams) -> Vec<Vec<RiverTexel>> {
+    jobs.iter()
+        .map(|job| compute_patch(job, n, params))
+        .collect()
+}
+
+/// All patches with rayon, parallel over patches and rows.
+pub fn compute_patches_rayon(
+    jobs: &[PatchJob],
+    n: u32,
+    params: &KernelParams,
+) -> Vec<Vec<RiverTexel>> {
+    jobs.par_iter()
+        .map(|job| {
+            let mut out = vec![RiverTexel::default(); (n * n) as usize];
+            out.par_chunks_mut(n as usize)
+                .enumerate()
+                .for_each(|(j, row)| {
+                    for (i, texel) in row.iter_mut().enumerate() {
+                        *texel = calculate_height(
+                            vertex_position(i as u32, j as u32, job.spacing),
+                            job.samples,
+                            params,
+                        );
+                    }
+                });
+            out
+        })
+        .collect()
+}

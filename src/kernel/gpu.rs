@@ -1,0 +1,357 @@
+//! The GPU river kernel (Chapter 7): the simple (7.3.1) and tiled (7.3.2) compute shaders, and the recording of
+//! one dispatch that computes every new patch of a frame. A range table (one [`GpuPatchJob`] per patch) maps the
+//! workgroups' y index to the patch's sample range and output slot.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::{KernelParams, PatchJob, RiverSample, RiverTexel};
+use crate::{
+    gpu::{
+        bindless::{Bindless, Slot},
+        pipeline::{BufferSetLayout, ComputePipeline},
+        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler,
+        Recorder, ScopeTiming,
+    },
+    shaders,
+};
+
+/// Which compute shader runs the kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+pub enum KernelVariant {
+    /// One invocation per vertex, samples read from the storage buffer (7.3.1).
+    Simple,
+    /// Samples staged in shared memory tile by tile (7.3.2).
+    Tiled,
+}
+
+impl KernelVariant {
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelVariant::Simple => "simple",
+            KernelVariant::Tiled => "tiled",
+        }
+    }
+}
+
+/// Workgroup shape and tile size, chosen by measurement (docs/kernel.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct KernelTuning {
+    pub workgroup_size: u32,
+    pub tile_size: u32,
+}
+
+impl Default for KernelTuning {
+    fn default() -> Self {
+        Self {
+            workgroup_size: 128,
+            tile_size: 128,
+        }
+    }
+}
+
+/// One row of the range table (std430, 16 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuPatchJob {
+    pub spacing: f32,
+    pub sample_offset: u32,
+    pub sample_count: u32,
+    pub slot: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct PushParams {
+    influence_distance: f32,
+    basin_depth: f32,
+    sea_level: f32,
+    basin_water_offset: f32,
+    grid_size: u32,
+}
+
+/// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
+/// minimum distance), layer 1 = (river half width, 0, 0, 0).
+pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const RIVER_TEXTURE_LAYERS: u32 = 2;
+
+/// Both kernel pipelines, ready to record dispatches.
+pub struct RiverKernel {
+    simple: ComputePipeline,
+    tiled: ComputePipeline,
+    inputs: BufferSetLayout,
+    pub grid_size: u32,
+    pub tuning: KernelTuning,
+}
+
+impl RiverKernel {
+    pub fn new(
+        ctx: &Context,
+        bindless: &Bindless,
+        grid_size: u32,
+        tuning: KernelTuning,
+    ) -> Result<Self, GpuError> {
+        let limit = ctx.properties.limits.max_compute_work_group_invocations;
+        if tuning.workgroup_size == 0 || tuning.workgroup_size > limit || tuning.tile_size == 0 {
+            return Err(GpuError::Invalid(format!(
+                "kernel workgroup size {} must be in [1, {limit}] and tile size {} > 0",
+                tuning.workgroup_size, tuning.tile_size
+            )));
+        }
+        let inputs = BufferSetLayout::new(ctx, 2, "river kernel inputs")?;
+        let layouts = [bindless.layout, inputs.layout];
+        let push = std::mem::size_of::<PushParams>() as u32;
+        let simple = ComputePipeline::new(
+            ctx,
+            shaders::KERNEL_SIMPLE_COMP,
+            "river kernel simple",
+            &layouts,
+            push,
+            &[tuning.workgroup_size],
+        )?;
+        let tiled = ComputePipeline::new(
+            ctx,
+            shaders::KERNEL_TILED_COMP,
+            "river kernel tiled",
+            &layouts,
+            push,
+            &[tuning.workgroup_size, tuning.tile_size],
+        )?;
+        Ok(Self {
+            simple,
+            tiled,
+            inputs,
+            grid_size,
+            tuning,
+        })
+    }
+
+    /// Records one dispatch computing every job into its slot's river texture (which must be in GENERAL layout).
+    /// The sample and range-table buffers are host-visible per-dispatch buffers, freed when the submission
+    /// completes. Returns their size in bytes (the frame's temporary sample memory).
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        bindless: &Bindless,
+        variant: KernelVariant,
+        jobs: &[GpuPatchJob],
+        samples: &[RiverSample],
+        params: &KernelParams,
+    ) -> Result<u64, GpuError> {
+        if jobs.is_empty() {
+            return Ok(0);
+        }
+        let ctx = rec.ctx();
+        let host_buffer = |name: &str, bytes: &[u8]| -> Result<Buffer, GpuError> {
+            let mut buffer = ctx.create_buffer(&BufferDesc {
+                name,
+                size: bytes.len().max(16) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })?;
+            buffer.write(0, bytes)?;
+            Ok(buffer)
+        };
+        let sample_buffer = host_buffer("river samples", bytemuck::cast_slice(samples))?;
+        let job_buffer = host_buffer("river range table", bytemuck::cast_slice(jobs))?;
+        let bytes = sample_buffer.size + job_buffer.size;
+        let set = rec.buffer_set(&self.inputs, &[&sample_buffer, &job_buffer])?;
+        let push = PushParams {
+            influence_distance: params.influence_distance,
+            basin_depth: params.basin_depth,
+            sea_level: params.sea_level,
+            basin_water_offset: params.basin_water_offset,
+            grid_size: self.grid_size,
+        };
+        let pipeline = match variant {
+            KernelVariant::Simple => &self.simple,
+            KernelVariant::Tiled => &self.tiled,
+        };
+        let vertices = self.grid_size * self.grid_size;
+        rec.dispatch(
+            pipeline,
+            &[bindless.set, set],
+            bytemuck::bytes_of(&push),
+            [
+                vertices.div_ceil(self.tuning.workgroup_size),
+                jobs.len() as u32,
+                1,
+            ],
+        );
+        rec.free_after_completion(sample_buffer);
+        rec.free_after_completion(job_buffer);
+        Ok(bytes)
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.simple.destroy(ctx);
+        self.tiled.destroy(ctx);
+        self.inputs.destroy(ctx);
+    }
+}
+
+/// Creates one patch's river texture.
+pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result<Image, GpuError> {
+    ctx.create_image(&ImageDesc {
+        name,
+        extent: vk::Extent2D {
+            width: grid_size,
+            height: grid_size,
+        },
+        layers: RIVER_TEXTURE_LAYERS,
+        format: RIVER_TEXTURE_FORMAT,
+        usage: vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC,
+        aspect: vk::ImageAspectFlags::COLOR,
+        array: true,
+    })
+}
+
+/// Flattens per-patch jobs into one sample array and a range table, with patch k written to `slots[k]`.
+pub fn pack_jobs(jobs: &[PatchJob], slots: &[Slot]) -> (Vec<GpuPatchJob>, Vec<RiverSample>) {
+    let mut samples = Vec::with_capacity(jobs.iter().map(|j| j.samples.len()).sum());
+    let table = jobs
+        .iter()
+        .zip(slots)
+        .map(|(job, slot)| {
+            let row = GpuPatchJob {
+                spacing: job.spacing,
+                sample_offset: samples.len() as u32,
+                sample_count: job.samples.len() as u32,
+                slot: slot.0,
+            };
+            samples.extend_from_slice(job.samples);
+            row
+        })
+        .collect();
+    (table, samples)
+}
+
+/// Decodes one read-back river texture (both layers, tightly packed RGBA32F) into texels.
+pub fn decode_texels(bytes: &[u8], grid_size: u32) -> Vec<RiverTexel> {
+    let floats: &[f32] = bytemuck::cast_slice(bytes);
+    let layer = (grid_size * grid_size) as usize;
+    (0..layer)
+        .map(|k| {
+            let m = &floats[4 * k..4 * k + 4];
+            RiverTexel {
+                terrain_height: m[0],
+                lerp_factor: m[1],
+                water_height: m[2],
+                min_distance: m[3],
+                river_width: floats[4 * (layer + k)],
+            }
+        })
+        .collect()
+}
+
+/// The result of [`run_batch`]: texels per patch and the GPU times of the scopes.
+pub struct BatchResult {
+    pub texels: Vec<Vec<RiverTexel>>,
+    pub timings: Vec<ScopeTiming>,
+    pub temporary_bytes: u64,
+}
+
+/// Computes `jobs` on the GPU in one dispatch, end to end: textures, upload, dispatch, readback. The scope
+/// "kernel" times the dispatch alone. For tests and benchmarks; the renderer keeps its textures resident instead.
+pub fn run_batch(
+    ctx: &Context,
+    bindless: &mut Bindless,
+    kernel: &RiverKernel,
+    variant: KernelVariant,
+    jobs: &[PatchJob],
+    params: &KernelParams,
+) -> Result<BatchResult, GpuError> {
+    let n = kernel.grid_size;
+    let mut slots = Vec::with_capacity(jobs.len());
+    let mut images = Vec::with_capacity(jobs.len());
+    let release = |bindless: &mut Bindless, slots: Vec<Slot>, images: Vec<Image>| {
+        for s in slots {
+            bindless.release(s);
+        }
+        for i in images {
+            ctx.retire_image(i);
+        }
+    };
+    for k in 0..jobs.len() {
+        let Some(slot) = bindless.allocate() else {
+            release(bindless, slots, images);
+            return Err(GpuError::Invalid(format!(
+                "batch of {} patches exceeds the {} bindless slots",
+                jobs.len(),
+                bindless.capacity
+            )));
+        };
+        let image = create_river_texture(ctx, n, &format!("river texture {k}"))?;
+        bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+        slots.push(slot);
+        images.push(image);
+    }
+    let texel_bytes = (n * n * 16 * RIVER_TEXTURE_LAYERS) as u64;
+    let readback = ctx.create_buffer(&BufferDesc {
+        name: "river readback",
+        size: texel_bytes * jobs.len() as u64,
+        usage: vk::BufferUsageFlags::TRANSFER_DST,
+        location: MemoryLocation::GpuToCpu,
+    })?;
+    let (table, samples) = pack_jobs(jobs, &slots);
+    let mut profiler = Profiler::new(ctx, 2, "river kernel timestamps")?;
+    let image_refs: Vec<&Image> = images.iter().collect();
+    let result = ctx.run_and_wait("river kernel batch", |rec| {
+        rec.image_transitions(
+            &image_refs,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        );
+        let scope = profiler.begin(rec, "kernel")?;
+        let bytes = kernel.record(rec, bindless, variant, &table, &samples, params)?;
+        profiler.end(rec, scope);
+        rec.memory_barrier(
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_READ,
+        );
+        for (k, image) in images.iter().enumerate() {
+            rec.copy_image_to_buffer(
+                image,
+                vk::ImageLayout::GENERAL,
+                &readback,
+                k as u64 * texel_bytes,
+            );
+        }
+        rec.buffer_barrier(
+            &readback,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+        Ok(bytes)
+    });
+    let outcome = result.and_then(|temporary_bytes| {
+        let timings = profiler.read(ctx)?;
+        let bytes = readback
+            .mapped()
+            .ok_or_else(|| GpuError::Invalid("readback buffer is not host-visible".into()))?;
+        let texels = (0..jobs.len())
+            .map(|k| {
+                let start = k * texel_bytes as usize;
+                decode_texels(&bytes[start..start + texel_bytes as usize], n)
+            })
+            .collect();
+        Ok(BatchResult {
+            texels,
+            timings,
+            temporary_bytes,
+        })
+    });
+    profiler.destroy(ctx);
+    ctx.retire_buffer(readback);
+    release(bindless, slots, images);
+    outcome
+}
