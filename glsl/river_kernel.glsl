@@ -45,36 +45,40 @@ Accumulators initAccumulators() {
     return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38);
 }
 
-// Procedure 3 for one sample, accumulated as in Procedure 4.
+// Procedure 3 for one sample, accumulated as in Procedure 4. On SIMD hardware the body runs under a mask for the
+// whole subgroup when any lane is in reach; lavapipe runs it under a mask always (measured: 0.7 ms for the
+// distance tests of a workload alone, 43 ms with the masked body), which is why the tiled kernel culls samples
+// per workgroup with a workgroup-uniform test.
 void accumulateSample(inout Accumulators acc, vec2 v, RiverSample s) {
     vec2 p = s.positionDerivative.xy;
     vec2 d = s.positionDerivative.zw;
     float dist = length(v - p);
-    if (dist > params.influenceDistance) return;
-    float halfWidth = s.heightWidth.y * 0.5;
-    vec2 n = vec2(d.y, -d.x);
-    float nn = n.x * n.x + n.y * n.y;
-    float t = nn > 0.0 ? ((v.x - p.x) * n.x + (v.y - p.y) * n.y) / nn : 0.0;
-    vec2 vn = p + t * n;
-    float projectionDistance = length(vn - v);
-    float normalDistance = length(p - vn);
-    float wDist = 1.0 - dist / params.influenceDistance;
-    float basinDepth = wDist * params.basinDepth;
-    acc.heightSum += wDist * s.heightWidth.x;
-    acc.weightSum += wDist;
-    acc.basinSum += basinDepth;
-    acc.widthSum += wDist * halfWidth;
-    if (projectionDistance < halfWidth && normalDistance <= halfWidth) {
-        float normalFactor = normalDistance / halfWidth;
-        float factor = normalFactor * normalFactor * normalFactor;
-        float wRiver = 1.0 - projectionDistance / halfWidth;
-        acc.inRiver = true;
-        acc.inRiverSum += wRiver * factor * basinDepth;
-        acc.inRiverWSum += wRiver;
+    if (dist <= params.influenceDistance) {
+        float halfWidth = s.heightWidth.y * 0.5;
+        vec2 n = vec2(d.y, -d.x);
+        float nn = n.x * n.x + n.y * n.y;
+        float t = nn > 0.0 ? ((v.x - p.x) * n.x + (v.y - p.y) * n.y) / nn : 0.0;
+        vec2 vn = p + t * n;
+        float projectionDistance = length(vn - v);
+        float normalDistance = length(p - vn);
+        float wDist = 1.0 - dist / params.influenceDistance;
+        float basinDepth = wDist * params.basinDepth;
+        acc.heightSum += wDist * s.heightWidth.x;
+        acc.weightSum += wDist;
+        acc.basinSum += basinDepth;
+        acc.widthSum += wDist * halfWidth;
+        if (projectionDistance < halfWidth && normalDistance <= halfWidth) {
+            float normalFactor = normalDistance / halfWidth;
+            float factor = normalFactor * normalFactor * normalFactor;
+            float wRiver = 1.0 - projectionDistance / halfWidth;
+            acc.inRiver = true;
+            acc.inRiverSum += wRiver * factor * basinDepth;
+            acc.inRiverWSum += wRiver;
+        }
+        float side = d.x * (v.y - p.y) - d.y * (v.x - p.x);
+        float signedDist = side > 0.0 ? -dist : dist;
+        if (abs(signedDist) < abs(acc.minDistance)) acc.minDistance = signedDist;
     }
-    float side = d.x * (v.y - p.y) - d.y * (v.x - p.x);
-    float signedDist = side > 0.0 ? -dist : dist;
-    if (abs(signedDist) < abs(acc.minDistance)) acc.minDistance = signedDist;
 }
 
 // Procedure 5: the five outputs of one vertex, written to the patch's slot.

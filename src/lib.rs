@@ -4,6 +4,7 @@
 //! Layers, dependencies pointing down: `kernel` (the river-height kernel: CPU reference and GPU dispatch),
 //! `config` (the XML of Table 6.1 / Appendix A), `gpu` (the only module that imports ash).
 
+pub mod bench;
 pub mod config;
 pub mod gpu;
 pub mod kernel;

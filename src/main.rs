@@ -4,8 +4,10 @@ use std::{path::PathBuf, process::ExitCode};
 
 use clap::{Parser, Subcommand};
 use riverplanet::{
+    bench,
     config::Config,
-    gpu::{self, ContextOptions},
+    gpu::{self, Context, ContextOptions},
+    kernel::gpu::KernelTuning,
 };
 
 #[derive(Parser)]
@@ -32,6 +34,38 @@ enum Command {
     },
     /// Print the resolved configuration of FILE (exit code 2 if it is invalid).
     Config { file: PathBuf },
+    /// Measure the river kernel variants side by side in one run.
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// CPU single-thread, CPU rayon, GPU simple and GPU tiled on identical input (Tables 9.1/9.2).
+    Kernel {
+        #[arg(long, default_value = "config/planet.xml")]
+        config: PathBuf,
+        /// The thesis's stress test: switch factor x10.
+        #[arg(long)]
+        stress: bool,
+        /// Repetitions per variant (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repetitions: usize,
+        /// Invocations per workgroup of the simple kernel.
+        #[arg(long, default_value_t = KernelTuning::default().simple_workgroup)]
+        simple_workgroup: u32,
+        /// Vertex block per workgroup of the tiled kernel, as WxH.
+        #[arg(long, default_value = "8x8", value_parser = parse_block)]
+        tiled_block: [u32; 2],
+        /// Samples staged per tile by the tiled kernel.
+        #[arg(long, default_value_t = KernelTuning::default().tile_size)]
+        tile_size: u32,
+        /// Write the report here as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -43,6 +77,13 @@ fn main() -> ExitCode {
     }
     match cli.command {
         Command::Info { json } => info(&options, json),
+        Command::Bench { what } => match run_bench(&options, what) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Config { file } => match Config::load(&file) {
             Ok(config) => {
                 log::info!("resolved configuration: {config:?}");
@@ -117,4 +158,85 @@ fn info(options: &ContextOptions, json: bool) -> ExitCode {
         eprintln!("error: no usable Vulkan device ({missing})");
         ExitCode::FAILURE
     }
+}
+
+fn load_config(path: &std::path::Path) -> anyhow::Result<Config> {
+    let config = Config::load(path)?;
+    log::info!("resolved configuration: {config:?}");
+    Ok(config)
+}
+
+fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()> {
+    match what {
+        BenchCommand::Kernel {
+            config,
+            stress,
+            repetitions,
+            simple_workgroup,
+            tiled_block,
+            tile_size,
+            json,
+        } => {
+            let config = load_config(&config)?;
+            let ctx = Context::new(options)?;
+            let tuning = KernelTuning {
+                simple_workgroup,
+                tiled_block,
+                tile_size,
+            };
+            let report = bench::kernel_bench(&ctx, &config, stress, repetitions, tuning)?;
+            let v = &report.variants;
+            println!(
+                "device {} | {} patches, {} samples, {} vertex-sample pairs ({} within reach) | rayon threads {}, LP_NUM_THREADS {}",
+                report.device,
+                report.patches,
+                report.samples,
+                report.pairs,
+                report.relevant_pairs,
+                report.threads.rayon_threads_used,
+                report.threads.lp_num_threads.as_deref().unwrap_or("unset"),
+            );
+            println!("  cpu single   {:>10.3} ms", v.cpu_single.kernel_ms);
+            println!("  cpu rayon    {:>10.3} ms", v.cpu_rayon.kernel_ms);
+            for (name, t) in [("gpu simple", &v.gpu_simple), ("gpu tiled", &v.gpu_tiled)] {
+                println!(
+                    "  {name:<12} {:>10.3} ms kernel, {:>10.3} ms end to end",
+                    t.kernel_ms,
+                    t.end_to_end_ms.unwrap_or(f64::NAN)
+                );
+            }
+            println!(
+                "  tiled/simple {:.3} | cpu single / gpu tiled end-to-end {:.2}x | max |diff| {:.3e} (height range {:?})",
+                report.ratios.tiled_over_simple,
+                report.ratios.cpu_single_over_gpu_tiled_end_to_end,
+                report.max_abs_diff,
+                report.height_range
+            );
+            let errors = ctx.validation_errors();
+            if !errors.is_empty() {
+                anyhow::bail!(
+                    "validation reported {} error(s): {}",
+                    errors.len(),
+                    errors[0]
+                );
+            }
+            if let Some(path) = json {
+                std::fs::write(&path, serde_json::to_string_pretty(&report)?)
+                    .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+            }
+            Ok(())
+        }
+    }
+}
+
+fn parse_block(text: &str) -> Result<[u32; 2], String> {
+    let (w, h) = text
+        .split_once('x')
+        .ok_or_else(|| format!("'{text}' is not of the form WxH (e.g. 8x8)"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{text}' is not of the form WxH (e.g. 8x8)"))
+    };
+    Ok([parse(w)?, parse(h)?])
 }

@@ -208,7 +208,8 @@ fn gpu_kernels_equal_the_cpu_reference() {
     for tuning in [
         KernelTuning::default(),
         KernelTuning {
-            workgroup_size: 64,
+            simple_workgroup: 128,
+            tiled_block: [16, 4],
             tile_size: 32,
         },
     ] {

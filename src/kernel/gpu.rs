@@ -33,18 +33,23 @@ impl KernelVariant {
     }
 }
 
-/// Workgroup shape and tile size, chosen by measurement (docs/kernel.md).
+/// Workgroup shapes and tile size, chosen by measurement (docs/kernel.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct KernelTuning {
-    pub workgroup_size: u32,
+    /// Invocations per workgroup of the simple kernel (1D over a patch's vertices).
+    pub simple_workgroup: u32,
+    /// Vertex block per workgroup of the tiled kernel (x, y).
+    pub tiled_block: [u32; 2],
+    /// Samples staged per tile by the tiled kernel.
     pub tile_size: u32,
 }
 
 impl Default for KernelTuning {
     fn default() -> Self {
         Self {
-            workgroup_size: 128,
-            tile_size: 128,
+            simple_workgroup: 64,
+            tiled_block: [8, 8],
+            tile_size: 256,
         }
     }
 }
@@ -91,10 +96,22 @@ impl RiverKernel {
         tuning: KernelTuning,
     ) -> Result<Self, GpuError> {
         let limit = ctx.properties.limits.max_compute_work_group_invocations;
-        if tuning.workgroup_size == 0 || tuning.workgroup_size > limit || tuning.tile_size == 0 {
+        let block = tuning.tiled_block[0] * tuning.tiled_block[1];
+        for (what, size) in [
+            ("simple workgroup", tuning.simple_workgroup),
+            ("tiled block", block),
+        ] {
+            if size == 0 || size > limit {
+                return Err(GpuError::Invalid(format!(
+                    "{what} of {size} invocations must be in [1, {limit}]"
+                )));
+            }
+        }
+        // The tiled kernel stages at most 32 samples per invocation (a bit mask) and 1024 invocations.
+        if tuning.tile_size == 0 || tuning.tile_size > 32 * block || block > 1024 {
             return Err(GpuError::Invalid(format!(
-                "kernel workgroup size {} must be in [1, {limit}] and tile size {} > 0",
-                tuning.workgroup_size, tuning.tile_size
+                "tile size {} must be in [1, 32 x block size {block}], block size at most 1024",
+                tuning.tile_size
             )));
         }
         let inputs = BufferSetLayout::new(ctx, 2, "river kernel inputs")?;
@@ -106,7 +123,7 @@ impl RiverKernel {
             "river kernel simple",
             &layouts,
             push,
-            &[tuning.workgroup_size],
+            &[tuning.simple_workgroup],
         )?;
         let tiled = ComputePipeline::new(
             ctx,
@@ -114,7 +131,11 @@ impl RiverKernel {
             "river kernel tiled",
             &layouts,
             push,
-            &[tuning.workgroup_size, tuning.tile_size],
+            &[
+                tuning.tiled_block[0],
+                tuning.tiled_block[1],
+                tuning.tile_size,
+            ],
         )?;
         Ok(Self {
             simple,
@@ -162,20 +183,23 @@ impl RiverKernel {
             basin_water_offset: params.basin_water_offset,
             grid_size: self.grid_size,
         };
-        let pipeline = match variant {
-            KernelVariant::Simple => &self.simple,
-            KernelVariant::Tiled => &self.tiled,
+        let n = self.grid_size;
+        let patches = jobs.len() as u32;
+        let (pipeline, groups) = match variant {
+            KernelVariant::Simple => (
+                &self.simple,
+                [(n * n).div_ceil(self.tuning.simple_workgroup), patches, 1],
+            ),
+            KernelVariant::Tiled => {
+                let [bx, by] = self.tuning.tiled_block;
+                (&self.tiled, [n.div_ceil(bx), n.div_ceil(by), patches])
+            }
         };
-        let vertices = self.grid_size * self.grid_size;
         rec.dispatch(
             pipeline,
             &[bindless.set, set],
             bytemuck::bytes_of(&push),
-            [
-                vertices.div_ceil(self.tuning.workgroup_size),
-                jobs.len() as u32,
-                1,
-            ],
+            groups,
         );
         rec.free_after_completion(sample_buffer);
         rec.free_after_completion(job_buffer);
