@@ -119,7 +119,7 @@ impl Default for Config {
                 continent_height: 2.0,
                 ocean_height: -4.0,
                 coast_perturbation: 3.0,
-                detail_amplitude: 6.0,
+                detail_amplitude: 8.0,
                 base_resolution: 129,
             },
             river: RiverConfig {

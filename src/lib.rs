@@ -6,8 +6,10 @@
 
 pub mod bench;
 pub mod config;
+pub mod export;
 pub mod gpu;
 pub mod kernel;
+pub mod planet;
 pub mod rng;
 
 /// SPIR-V of every shader in `glsl/`, compiled by build.rs.

@@ -34,6 +34,23 @@ enum Command {
     },
     /// Print the resolved configuration of FILE (exit code 2 if it is invalid).
     Config { file: PathBuf },
+    /// Generate the planet: per-face heightmaps, statistics and (with --preview) an unfolded picture.
+    Generate {
+        #[arg(long, default_value = "config/planet.xml")]
+        config: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Override master-seed.
+        #[arg(long)]
+        seed: Option<u32>,
+        /// Also write DIR/preview.png, the six faces unfolded.
+        #[arg(long)]
+        preview: bool,
+        /// Also write DIR/continents.png, land and sea as an equirectangular image (input for continents-from-file).
+        #[arg(long)]
+        equirect: bool,
+    },
     /// Measure the river kernel variants side by side in one run.
     Bench {
         #[command(subcommand)]
@@ -77,6 +94,19 @@ fn main() -> ExitCode {
     }
     match cli.command {
         Command::Info { json } => info(&options, json),
+        Command::Generate {
+            config,
+            out,
+            seed,
+            preview,
+            equirect,
+        } => match generate(&config, &out, seed, preview, equirect) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Bench { what } => match run_bench(&options, what) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
@@ -239,4 +269,58 @@ fn parse_block(text: &str) -> Result<[u32; 2], String> {
             .map_err(|_| format!("'{text}' is not of the form WxH (e.g. 8x8)"))
     };
     Ok([parse(w)?, parse(h)?])
+}
+
+fn generate(
+    config_path: &std::path::Path,
+    out: &std::path::Path,
+    seed: Option<u32>,
+    preview: bool,
+    equirect: bool,
+) -> anyhow::Result<()> {
+    use std::io::IsTerminal;
+    let config = load_config(config_path)?;
+    let seed = seed.unwrap_or_else(|| config.resolve_seed());
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(100));
+        Some(bar)
+    } else {
+        None
+    };
+    let planet = riverplanet::planet::Planet::generate(&config, seed, |stage| {
+        if let Some(bar) = &bar {
+            bar.set_message(stage.to_string());
+        }
+    })?;
+    let t = std::time::Instant::now();
+    if let Some(bar) = &bar {
+        bar.set_message("writing");
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
+    riverplanet::export::write_faces(&planet, out)?;
+    if preview {
+        let path = out.join("preview.png");
+        riverplanet::export::preview(&planet, 256)
+            .save(&path)
+            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    }
+    if equirect {
+        let path = out.join("continents.png");
+        riverplanet::export::equirectangular_land(&planet, 1024)
+            .save(&path)
+            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    }
+    let mut stats = planet.stats.clone();
+    stats
+        .timings_ms
+        .insert("write".to_string(), t.elapsed().as_secs_f64() * 1e3);
+    let path = out.join("stats.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&stats)?)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    Ok(())
 }

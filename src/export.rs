@@ -1,0 +1,174 @@
+//! What `riverplanet generate` writes: per-face 16-bit heightmaps with their layout, statistics, and an unfolded
+//! colour preview.
+
+use std::{fs, path::Path};
+
+use image::{ImageBuffer, Luma, Rgb, RgbImage};
+use rayon::prelude::*;
+use serde_json::json;
+
+use crate::planet::{
+    cube::{cube_point, FACES, FACE_AXES},
+    Planet,
+};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("cannot write {path}: {message}")]
+    Write { path: String, message: String },
+}
+
+fn write_err(path: &Path, e: impl std::fmt::Display) -> ExportError {
+    ExportError::Write {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// Writes `dir/faces/face{0..5}.png` (16-bit grey, one pixel per finest-level vertex, `min_height..max_height`
+/// mapped to 0..65535; pixel (i, j) is lattice point u = -1 + i step, v = -1 + j step) and `dir/faces/layout.json`.
+pub fn write_faces(planet: &Planet, dir: &Path) -> Result<(), ExportError> {
+    let faces_dir = dir.join("faces");
+    fs::create_dir_all(&faces_dir).map_err(|e| write_err(&faces_dir, e))?;
+    let lattice = &planet.heights;
+    let side = lattice.side() as u32;
+    let (lo, hi) = (planet.stats.min_height, planet.stats.max_height);
+    let scale = if hi > lo { 65535.0 / (hi - lo) } else { 0.0 };
+    (0..FACES).into_par_iter().try_for_each(|face| {
+        let image: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_fn(side, side, |i, j| {
+            Luma([((lattice.get(face, i, j) - lo) * scale)
+                .round()
+                .clamp(0.0, 65535.0) as u16])
+        });
+        let path = faces_dir.join(format!("face{face}.png"));
+        let file = fs::File::create(&path).map_err(|e| write_err(&path, e))?;
+        let encoder = image::codecs::png::PngEncoder::new_with_quality(
+            std::io::BufWriter::new(file),
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Sub,
+        );
+        image
+            .write_with_encoder(encoder)
+            .map_err(|e| write_err(&path, e))
+    })?;
+    let step = 2.0 / lattice.cells as f64;
+    let layout: Vec<_> = (0..FACES)
+        .map(|face| {
+            let (_, a, b) = FACE_AXES[face];
+            json!({
+                "face": face,
+                "origin": cube_point(face, -1.0, -1.0).to_array(),
+                "step_x": (a * step).to_array(),
+                "step_y": (b * step).to_array(),
+                "size": [side, side],
+            })
+        })
+        .collect();
+    let path = faces_dir.join("layout.json");
+    let text = serde_json::to_string_pretty(&json!({ "faces": layout }))
+        .map_err(|e| write_err(&path, e))?;
+    fs::write(&path, text).map_err(|e| write_err(&path, e))
+}
+
+/// Terrain colour for a height (sea by depth, then sand, grass, rock, snow).
+pub fn terrain_colour(h: f32, sea_level: f32, max_height: f32) -> [u8; 3] {
+    if h <= sea_level {
+        let depth = ((sea_level - h) / 6.0).clamp(0.0, 1.0);
+        let lerp = |a: f32, b: f32| (a + (b - a) * depth) as u8;
+        return [lerp(40.0, 8.0), lerp(110.0, 30.0), lerp(180.0, 90.0)];
+    }
+    let t = ((h - sea_level) / (max_height - sea_level).max(1e-3)).clamp(0.0, 1.0);
+    let stops: [(f32, [f32; 3]); 5] = [
+        (0.0, [194.0, 178.0, 128.0]),
+        (0.05, [86.0, 140.0, 60.0]),
+        (0.35, [60.0, 100.0, 45.0]),
+        (0.6, [120.0, 110.0, 100.0]),
+        (1.0, [245.0, 245.0, 250.0]),
+    ];
+    for w in stops.windows(2) {
+        let ((t0, c0), (t1, c1)) = (w[0], w[1]);
+        if t <= t1 {
+            let f = (t - t0) / (t1 - t0);
+            return [0, 1, 2].map(|k| (c0[k] + (c1[k] - c0[k]) * f) as u8);
+        }
+    }
+    [245, 245, 250]
+}
+
+/// Where each face sits in the unfolded cross (in face-size units), and how its (u, v) map to the cross's
+/// (right, down): the cross is +Y on top, then -X, +Z, +X, -Z in a row, -Y below (a view from outside).
+const CROSS: [(u32, u32); FACES] = [(2, 1), (0, 1), (1, 0), (1, 2), (1, 1), (3, 1)];
+
+/// An unfolded colour picture of the six faces at `size` pixels per face (layout in docs/planet.md).
+pub fn preview(planet: &Planet, size: u32) -> RgbImage {
+    let mut image = RgbImage::from_pixel(4 * size, 3 * size, Rgb([20, 20, 24]));
+    let max = planet.stats.max_height;
+    for (face, &(cx, cy)) in CROSS.iter().enumerate() {
+        for py in 0..size {
+            for px in 0..size {
+                let (u, v) = cross_uv(face, px, py, size);
+                let p = cross_direction(face, u, v);
+                let c = terrain_colour(planet.height_at(p), planet.sea_level, max);
+                image.put_pixel(cx * size + px, cy * size + py, Rgb(c));
+            }
+        }
+    }
+    image
+}
+
+/// The (u, v) on `face` seen at pixel (px, py) of its square in the cross: the cross shows each face from
+/// outside with +Y up where possible.
+fn cross_uv(face: usize, px: u32, py: u32, size: u32) -> (f64, f64) {
+    let s = (px as f64 + 0.5) / size as f64 * 2.0 - 1.0;
+    let t = 1.0 - (py as f64 + 0.5) / size as f64 * 2.0;
+    // Screen right/up in terms of 3D directions for each square of the cross.
+    let (right, up) = cross_axes(face);
+    let (_, a, b) = FACE_AXES[face];
+    let dir = right * s + up * t;
+    (dir.dot(a), dir.dot(b))
+}
+
+fn cross_direction(face: usize, u: f64, v: f64) -> glam::DVec3 {
+    cube_point(face, u, v).normalize()
+}
+
+/// Screen right and up (3D) of each face in the cross, seen from outside: the equatorial faces with +Y up, +Y with
+/// -Z up and -Y with +Z up, so that neighbouring squares continue each other.
+fn cross_axes(face: usize) -> (glam::DVec3, glam::DVec3) {
+    use glam::DVec3 as V;
+    match face {
+        0 => (V::NEG_Z, V::Y), // +X
+        1 => (V::Z, V::Y),     // -X
+        2 => (V::X, V::NEG_Z), // +Y (above +Z)
+        3 => (V::X, V::Z),     // -Y (below +Z)
+        4 => (V::X, V::Y),     // +Z
+        _ => (V::NEG_X, V::Y), // -Z
+    }
+}
+
+/// Maps a unit direction to its pixel in the cross, for drawing overlays.
+pub fn cross_pixel(p: glam::DVec3, size: u32) -> (f64, f64) {
+    let (face, _, _) = crate::planet::cube::face_of(p);
+    let (n, _, _) = FACE_AXES[face];
+    let q = p / p.dot(n);
+    let (right, up) = cross_axes(face);
+    let (s, t) = (q.dot(right), q.dot(up));
+    let (cx, cy) = CROSS[face];
+    (
+        cx as f64 * size as f64 + (s + 1.0) * 0.5 * size as f64,
+        cy as f64 * size as f64 + (1.0 - t) * 0.5 * size as f64,
+    )
+}
+
+/// The planet's land (white) and sea (black) as an equirectangular image `width x width/2`: the format that
+/// `continents-from-file` reads back.
+pub fn equirectangular_land(planet: &Planet, width: u32) -> image::GrayImage {
+    let height = width / 2;
+    image::GrayImage::from_fn(width, height, |x, y| {
+        let lon = ((x as f64 + 0.5) / width as f64 * 360.0 - 180.0).to_radians();
+        let lat = (90.0 - (y as f64 + 0.5) / height as f64 * 180.0).to_radians();
+        // Inverse of planet::lon_lat: lon from +X towards -Z, latitude towards +Y.
+        let p = glam::DVec3::new(lat.cos() * lon.cos(), lat.sin(), -lat.cos() * lon.sin());
+        image::Luma([if planet.is_land(p) { 255 } else { 0 }])
+    })
+}

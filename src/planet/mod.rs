@@ -1,0 +1,423 @@
+//! The planet model (Chapters 3 and 4): the cube-sphere, continents, mountains and diamond-square heights.
+
+pub mod continents;
+pub mod cube;
+pub mod heights;
+
+use std::{path::Path, time::Instant};
+
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use self::{
+    continents::{ContinentError, ContinentImage, FeaturePoints},
+    cube::FACES,
+    heights::{area_weight, FaceLattice},
+};
+use crate::{config::Config, rng::Rng};
+
+const STREAM_MOUNTAINS: u64 = 0x40_0001;
+
+/// Longitude and latitude in degrees of a direction: latitude from the equator towards +Y (north), longitude
+/// from +X, east (towards -Z) positive.
+pub fn lon_lat(p: DVec3) -> (f64, f64) {
+    let p = p.normalize();
+    (
+        (-p.z).atan2(p.x).to_degrees(),
+        p.y.clamp(-1.0, 1.0).asin().to_degrees(),
+    )
+}
+
+/// A mountain of Section 4.2: the 3x3 mask's centre, kept as a river source.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Mountain {
+    pub face: usize,
+    /// Position on the base lattice.
+    pub i: u32,
+    pub j: u32,
+    pub direction: [f64; 3],
+    pub height: f32,
+}
+
+/// Problems generating a planet.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanetError {
+    #[error(transparent)]
+    Continents(#[from] ContinentError),
+    #[error(
+        "base-resolution {base} must be (vertices - 1) x 2^b + 1 for some b <= max-level-of-detail {max} \
+         (with vertices {vertices}: {valid})"
+    )]
+    BaseResolution {
+        base: u32,
+        vertices: u32,
+        max: u32,
+        valid: String,
+    },
+}
+
+/// What `generate` reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanetStats {
+    pub seed: u32,
+    /// Share of the sphere's area above sea level at the finest level, in percent.
+    pub landmass_percent: f64,
+    /// Share of the sphere's area that the continents (Voronoi or image, after perturbation) cover, in percent.
+    pub continent_percent: f64,
+    pub continents: usize,
+    pub mountains: usize,
+    pub continental_weight: f64,
+    pub min_height: f32,
+    pub max_height: f32,
+    pub base_level: u32,
+    pub finest_cells: u32,
+    /// Milliseconds per stage (summed over the landmass corrections).
+    pub timings_ms: std::collections::BTreeMap<String, f64>,
+    pub memory_bytes: u64,
+}
+
+/// A generated planet: its heights at every level of detail, and its mountains.
+pub struct Planet {
+    pub radius: f64,
+    pub sea_level: f32,
+    /// Vertices per patch edge (33).
+    pub vertices: u32,
+    pub max_level: u32,
+    pub heights: FaceLattice,
+    pub mountains: Vec<Mountain>,
+    pub features: Option<FeaturePoints>,
+    pub stats: PlanetStats,
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+impl Planet {
+    /// Generates the planet of `config` with `seed` (Chapter 4). `progress` is told each finished stage.
+    pub fn generate(
+        config: &Config,
+        seed: u32,
+        mut progress: impl FnMut(&str),
+    ) -> Result<Self, PlanetError> {
+        let p = &config.planet;
+        let r = &config.rendering;
+        let cells_per_patch = r.vertices - 1;
+        let base_cells = p.base_resolution - 1;
+        let base_level = (0..=r.max_level_of_detail)
+            .find(|l| cells_per_patch << l == base_cells)
+            .ok_or_else(|| PlanetError::BaseResolution {
+                base: p.base_resolution,
+                vertices: r.vertices,
+                max: r.max_level_of_detail,
+                valid: (0..=r.max_level_of_detail.min(6))
+                    .map(|l| ((cells_per_patch << l) + 1).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        let mut timings = std::collections::BTreeMap::<String, f64>::new();
+        let mut time = |stage: &str, since: Instant| {
+            *timings.entry(stage.to_string()).or_default() += ms_since(since)
+        };
+        let seed64 = seed as u64;
+
+        // Continents on the base lattice (4.1).
+        let t = Instant::now();
+        let base = FaceLattice::new(base_cells, 0.0);
+        let points: Vec<(usize, u32, u32)> = (0..FACES)
+            .flat_map(|f| {
+                (0..=base_cells).flat_map(move |j| (0..=base_cells).map(move |i| (f, i, j)))
+            })
+            .collect();
+        let cell_angle = std::f64::consts::FRAC_PI_2 / base_cells as f64;
+        let amplitude = p.coast_perturbation as f64 * cell_angle;
+        let weights: Vec<f64> = points
+            .iter()
+            .map(|&(_, i, j)| area_weight(base_cells, i, j))
+            .collect();
+        // The continent map as a function of a threshold: an image gives land directly; the Voronoi diagram gives
+        // each point's ratio of continental to water distance, and a weight turns ratios into land.
+        let (image_land, ratios, features) = if p.continents_from_file {
+            let image = ContinentImage::load(Path::new(&p.continents_image))?;
+            let land: Vec<bool> = points
+                .par_iter()
+                .map(|&(f, i, j)| {
+                    let d = base.direction(base.key(f, i, j));
+                    image.is_land(continents::perturb(seed64, d, amplitude))
+                })
+                .collect();
+            (Some(land), Vec::new(), None)
+        } else {
+            let features = FeaturePoints::generate(seed64, p.continents as usize);
+            let ratios: Vec<f64> = points
+                .par_iter()
+                .map(|&(f, i, j)| {
+                    let d = base.direction(base.key(f, i, j));
+                    features.ratio(continents::perturb(seed64, d, amplitude))
+                })
+                .collect();
+            (None, ratios, Some(features))
+        };
+        time("continents", t);
+        progress("continents");
+
+        // Diamond-square averages coastal points with the sea floor, which moves coasts inland. The share is
+        // measured on the finished heights and the Voronoi threshold corrected (at most twice) until it is
+        // within a quarter of a percentage point of the request.
+        let target = p.landmass_percentage as f64 / 100.0;
+        let mut requested = target;
+        let total: f64 = weights.iter().sum();
+        let mut attempt = 0;
+        loop {
+            let t = Instant::now();
+            let (land, weight) = match &image_land {
+                Some(land) => (land.clone(), 0.0),
+                None => {
+                    let weight = continents::weight_for_share(
+                        &ratios,
+                        &weights,
+                        requested.clamp(0.001, 0.999),
+                    );
+                    (
+                        ratios
+                            .iter()
+                            .map(|r| r * weight < 1.0)
+                            .collect::<Vec<bool>>(),
+                        weight,
+                    )
+                }
+            };
+            let continent_share: f64 = land
+                .iter()
+                .zip(&weights)
+                .filter(|(l, _)| **l)
+                .map(|(_, w)| w)
+                .sum::<f64>()
+                / total;
+            let mut base = FaceLattice::new(base_cells, 0.0);
+            for (k, &(f, i, j)) in points.iter().enumerate() {
+                let index = base.index(f, i, j);
+                base.data[index] = if land[k] {
+                    p.continent_height
+                } else {
+                    p.ocean_height
+                };
+            }
+            let mountains = seed_mountains(&mut base, config, seed64);
+            time("mountains", t);
+            progress("mountains");
+
+            let t = Instant::now();
+            let heights = diamond_square(&base, config, base_level, seed64, &mut progress);
+            time("diamond-square", t);
+
+            let t = Instant::now();
+            let (landmass, min_height, max_height) = measure(&heights, p.sea_level_height);
+            time("measure", t);
+            attempt += 1;
+            if image_land.is_some() || (landmass - target).abs() <= 0.0025 || attempt == 3 {
+                break Ok(Self::finish(
+                    config,
+                    heights,
+                    mountains,
+                    features,
+                    PlanetStats {
+                        seed,
+                        landmass_percent: landmass * 100.0,
+                        continent_percent: continent_share * 100.0,
+                        continents: if p.continents_from_file {
+                            0
+                        } else {
+                            p.continents as usize
+                        },
+                        mountains: 0,
+                        continental_weight: weight,
+                        min_height,
+                        max_height,
+                        base_level,
+                        finest_cells: cells_per_patch << r.max_level_of_detail,
+                        timings_ms: timings,
+                        memory_bytes: 0,
+                    },
+                ));
+            }
+            requested += target - landmass;
+        }
+    }
+
+    fn finish(
+        config: &Config,
+        heights: FaceLattice,
+        mountains: Vec<Mountain>,
+        features: Option<FeaturePoints>,
+        mut stats: PlanetStats,
+    ) -> Self {
+        stats.mountains = mountains.len();
+        stats.memory_bytes = heights.bytes();
+        log::info!("planet: {stats:?}");
+        Self {
+            radius: config.planet.radius as f64,
+            sea_level: config.planet.sea_level_height,
+            vertices: config.rendering.vertices,
+            max_level: config.rendering.max_level_of_detail,
+            heights,
+            mountains,
+            features,
+            stats,
+        }
+    }
+
+    /// The base height at a unit direction, bilinear on the finest lattice.
+    pub fn height_at(&self, direction: DVec3) -> f32 {
+        let (face, u, v) = cube::face_of(direction);
+        let c = self.heights.cells as f64;
+        let x = ((u + 1.0) * 0.5 * c).clamp(0.0, c);
+        let y = ((v + 1.0) * 0.5 * c).clamp(0.0, c);
+        let (i, j) = (
+            (x.floor() as u32).min(self.heights.cells - 1),
+            (y.floor() as u32).min(self.heights.cells - 1),
+        );
+        let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
+        let h = |di, dj| self.heights.get(face, i + di, j + dj);
+        let bottom = h(0, 0) * (1.0 - fx) + h(1, 0) * fx;
+        let top = h(0, 1) * (1.0 - fx) + h(1, 1) * fx;
+        bottom * (1.0 - fy) + top * fy
+    }
+
+    /// Whether a direction is land on the base terrain (above sea level).
+    pub fn is_land(&self, direction: DVec3) -> bool {
+        self.height_at(direction) > self.sea_level
+    }
+}
+
+/// Spreads the base lattice onto the finest lattice and runs diamond-square from the base level down (3.6), the
+/// displacement halving per level.
+fn diamond_square(
+    base: &FaceLattice,
+    config: &Config,
+    base_level: u32,
+    seed: u64,
+    progress: &mut impl FnMut(&str),
+) -> FaceLattice {
+    let finest_cells = (config.rendering.vertices - 1) << config.rendering.max_level_of_detail;
+    let scale = finest_cells / base.cells;
+    let mut heights = FaceLattice::new(finest_cells, 0.0);
+    for f in 0..FACES {
+        for j in 0..=base.cells {
+            for i in 0..=base.cells {
+                let index = heights.index(f, i * scale, j * scale);
+                heights.data[index] = base.get(f, i, j);
+            }
+        }
+    }
+    let mut half = scale / 2;
+    let mut level = base_level;
+    while half >= 1 {
+        let amplitude = config.planet.detail_amplitude / (1u32 << (level + 1)) as f32;
+        heights.diamond_square_step(seed, half, amplitude);
+        half /= 2;
+        level += 1;
+        progress("diamond-square level");
+    }
+    heights
+}
+
+/// Seeds `mountains-per-continent x continents` mountains (4.2): a 3x3 mask on the coarsest heightmap (level 0,
+/// whose cells are `base.cells / (vertices - 1)` base cells wide), placed where all nine points are continental and
+/// not part of another mountain. The centre gets `max-mountain-height`, the eight around it
+/// `mountain-shoulder-factor` of that; the mask is spread bilinearly onto the base lattice, so a mountain is a
+/// peak about four level-0 cells wide. Masks and their ring stay inside a face,
+/// so shared border points are never touched.
+fn seed_mountains(base: &mut FaceLattice, config: &Config, seed: u64) -> Vec<Mountain> {
+    let p = &config.planet;
+    let wanted = (p.mountains_per_continent * p.continents.max(1)) as usize;
+    let mut rng = Rng::new(seed, &[STREAM_MOUNTAINS]);
+    let coarse = config.rendering.vertices - 1;
+    let k = base.cells / coarse;
+    let mut used = vec![false; FACES * (coarse as usize + 1).pow(2)];
+    let used_index = |f: usize, x: u32, y: u32| {
+        (f * (coarse as usize + 1) + y as usize) * (coarse as usize + 1) + x as usize
+    };
+    let shoulder = p.max_mountain_height * p.mountain_shoulder_factor;
+    let mut mountains = Vec::new();
+    for _ in 0..wanted * 200 {
+        if mountains.len() == wanted {
+            break;
+        }
+        let face = rng.below(FACES as u64) as usize;
+        // The mask and its surrounding ring stay off the face border, which adjacent faces share.
+        let ci = 3 + rng.below(coarse as u64 - 5) as u32;
+        let cj = 3 + rng.below(coarse as u64 - 5) as u32;
+        let free = (0..9).all(|m| {
+            let (x, y) = (ci + m % 3 - 1, cj + m / 3 - 1);
+            base.get(face, x * k, y * k) > p.sea_level_height && !used[used_index(face, x, y)]
+        });
+        if !free {
+            continue;
+        }
+        for y in cj - 2..=cj + 2 {
+            for x in ci - 2..=ci + 2 {
+                used[used_index(face, x, y)] = true;
+            }
+        }
+        // Mask value at level-0 offset (dx, dy) from the centre: top, shoulders, then the land around.
+        let mask = |dx: i32, dy: i32| match dx.abs().max(dy.abs()) {
+            0 => p.max_mountain_height,
+            1 => shoulder,
+            _ => p.continent_height,
+        };
+        let (i0, j0) = (ci * k, cj * k);
+        for j in (j0 - 2 * k)..=(j0 + 2 * k) {
+            for i in (i0 - 2 * k)..=(i0 + 2 * k) {
+                let fx = (i as f32 - i0 as f32) / k as f32;
+                let fy = (j as f32 - j0 as f32) / k as f32;
+                let (x0, y0) = (fx.floor() as i32, fy.floor() as i32);
+                let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
+                let value = mask(x0, y0) * (1.0 - tx) * (1.0 - ty)
+                    + mask(x0 + 1, y0) * tx * (1.0 - ty)
+                    + mask(x0, y0 + 1) * (1.0 - tx) * ty
+                    + mask(x0 + 1, y0 + 1) * tx * ty;
+                let index = base.index(face, i, j);
+                base.data[index] = base.data[index].max(value);
+            }
+        }
+        let direction = base.direction(base.key(face, i0, j0));
+        mountains.push(Mountain {
+            face,
+            i: i0,
+            j: j0,
+            direction: direction.to_array(),
+            height: p.max_mountain_height,
+        });
+    }
+    mountains
+}
+
+/// The area share above sea level, and the height range, of a lattice.
+fn measure(heights: &FaceLattice, sea_level: f32) -> (f64, f32, f32) {
+    let side = heights.side();
+    let c = heights.cells;
+    let (land, total, lo, hi) = (0..FACES * side)
+        .into_par_iter()
+        .map(|row| {
+            let (face, j) = (row / side, (row % side) as u32);
+            let mut acc = (0.0, 0.0, f32::MAX, f32::MIN);
+            for i in 0..=c {
+                let h = heights.get(face, i, j);
+                let w = area_weight(c, i, j);
+                acc.1 += w;
+                if h > sea_level {
+                    acc.0 += w;
+                }
+                acc.2 = acc.2.min(h);
+                acc.3 = acc.3.max(h);
+            }
+            acc
+        })
+        .reduce(
+            || (0.0, 0.0, f32::MAX, f32::MIN),
+            |a, b| (a.0 + b.0, a.1 + b.1, a.2.min(b.2), a.3.max(b.3)),
+        );
+    (land / total, lo, hi)
+}
