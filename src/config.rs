@@ -75,6 +75,9 @@ pub struct RiverConfig {
     pub hull_levels: u32,
     /// Probability that a segment spawns a tributary when subdivided (5.2.3).
     pub tributary_probability: f32,
+    /// Largest random displacement of a knot when a segment is subdivided, as a fraction of segment length / pieces
+    /// (5.2.2).
+    pub displacement: f32,
     /// Directions tried per mountain before it is given up as a river source (5.2.1).
     pub max_attempts: u32,
     /// Samples per half river width (6.4: "three sample points for every distance half the width").
@@ -132,6 +135,7 @@ impl Default for Config {
                 segments: 5,
                 hull_levels: 3,
                 tributary_probability: 0.5,
+                displacement: 0.3,
                 max_attempts: 16,
                 samples_per_half_width: 3,
             },
@@ -189,6 +193,7 @@ struct RawRiver {
     segments: Option<String>,
     hull_levels: Option<String>,
     tributary_probability: Option<String>,
+    displacement: Option<String>,
     max_attempts: Option<String>,
     samples_per_half_width: Option<String>,
 }
@@ -505,6 +510,12 @@ impl Config {
                 "tributary-probability",
                 &v.tributary_probability,
                 dv.tributary_probability,
+                Range::Closed(0.0, 1.0),
+            )?,
+            displacement: r.f32(
+                "displacement",
+                &v.displacement,
+                dv.displacement,
                 Range::Closed(0.0, 1.0),
             )?,
             max_attempts: r.u32("max-attempts", &v.max_attempts, dv.max_attempts, 1, 1000)?,

@@ -172,3 +172,80 @@ pub fn equirectangular_land(planet: &Planet, width: u32) -> image::GrayImage {
         image::Luma([if planet.is_land(p) { 255 } else { 0 }])
     })
 }
+
+/// GeoJSON LineStrings of every river and tributary at `depth` (longitude/latitude in degrees).
+pub fn rivers_geojson(
+    network: &crate::river::network::RiverNetwork,
+    depth: u32,
+) -> serde_json::Value {
+    let mut features = Vec::new();
+    for system in &network.systems {
+        let lines = crate::river::samples::polylines(network, system, depth);
+        let name = |branch: u64| {
+            if lines.first().is_some_and(|l| l.key == branch) {
+                format!("{}", system.id)
+            } else {
+                format!("{}-{:08x}", system.id, branch as u32)
+            }
+        };
+        for line in &lines {
+            let coordinates: Vec<[f64; 2]> = line
+                .points
+                .iter()
+                .map(|p| {
+                    let (lon, lat) = crate::planet::lon_lat(*p);
+                    [lon, lat]
+                })
+                .collect();
+            features.push(json!({
+                "type": "Feature",
+                "geometry": { "type": "LineString", "coordinates": coordinates },
+                "properties": {
+                    "id": name(line.key),
+                    "parent": line.parent.map(name),
+                    "width_start": line.widths.0,
+                    "width_end": line.widths.1,
+                    "lod": depth,
+                },
+            }));
+        }
+    }
+    json!({ "type": "FeatureCollection", "features": features })
+}
+
+/// Draws every river of `network` at `depth` onto a [`preview`] of `size` pixels per face.
+pub fn draw_rivers(
+    image: &mut RgbImage,
+    network: &crate::river::network::RiverNetwork,
+    depth: u32,
+    size: u32,
+) {
+    for system in &network.systems {
+        for line in crate::river::samples::polylines(network, system, depth) {
+            let colour = if line.parent.is_none() {
+                Rgb([120, 200, 255])
+            } else {
+                Rgb([60, 160, 240])
+            };
+            for pair in line.points.windows(2) {
+                let (a, b) = (cross_pixel(pair[0], size), cross_pixel(pair[1], size));
+                // Skip segments that jump across the cross's gaps.
+                if (a.0 - b.0).abs() + (a.1 - b.1).abs() > size as f64 / 4.0 {
+                    continue;
+                }
+                let steps = ((a.0 - b.0).abs().max((a.1 - b.1).abs()).ceil() as u32).max(1);
+                for k in 0..=steps {
+                    let f = k as f64 / steps as f64;
+                    let (x, y) = (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f);
+                    if x >= 0.0
+                        && y >= 0.0
+                        && (x as u32) < image.width()
+                        && (y as u32) < image.height()
+                    {
+                        image.put_pixel(x as u32, y as u32, colour);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -10,6 +10,7 @@ pub mod export;
 pub mod gpu;
 pub mod kernel;
 pub mod planet;
+pub mod river;
 pub mod rng;
 
 /// SPIR-V of every shader in `glsl/`, compiled by build.rs.

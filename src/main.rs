@@ -293,6 +293,14 @@ fn generate(
             bar.set_message(stage.to_string());
         }
     })?;
+    if let Some(bar) = &bar {
+        bar.set_message("rivers");
+    }
+    let t = std::time::Instant::now();
+    let network = riverplanet::river::network::RiverNetwork::generate(&planet, &config, seed);
+    let river_ms = t.elapsed().as_secs_f64() * 1e3;
+    let geojson_depth = 2;
+    let (rivers, tributaries) = network.count(config.river.hull_levels);
     let t = std::time::Instant::now();
     if let Some(bar) = &bar {
         bar.set_message("writing");
@@ -302,7 +310,9 @@ fn generate(
     riverplanet::export::write_faces(&planet, out)?;
     if preview {
         let path = out.join("preview.png");
-        riverplanet::export::preview(&planet, 256)
+        let mut image = riverplanet::export::preview(&planet, 256);
+        riverplanet::export::draw_rivers(&mut image, &network, geojson_depth, 256);
+        image
             .save(&path)
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     }
@@ -312,12 +322,22 @@ fn generate(
             .save(&path)
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     }
+    let path = out.join("rivers.geojson");
+    let geojson = riverplanet::export::rivers_geojson(&network, geojson_depth);
+    std::fs::write(&path, serde_json::to_string(&geojson)?)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     let mut stats = planet.stats.clone();
+    stats.timings_ms.insert("rivers".to_string(), river_ms);
     stats
         .timings_ms
         .insert("write".to_string(), t.elapsed().as_secs_f64() * 1e3);
+    let mut value = serde_json::to_value(&stats)?;
+    value["rivers"] = serde_json::json!(rivers);
+    value["tributaries"] = serde_json::json!(tributaries);
+    value["abandoned_river_sources"] = serde_json::json!(network.abandoned_sources);
+    value["rivers_geojson_lod"] = serde_json::json!(geojson_depth);
     let path = out.join("stats.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&stats)?)
+    std::fs::write(&path, serde_json::to_string_pretty(&value)?)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     if let Some(bar) = bar {
         bar.finish_and_clear();

@@ -1,0 +1,6 @@
+//! River networks (Chapter 5) and their samples (Section 6.4).
+
+pub mod hull;
+pub mod network;
+pub mod samples;
+pub mod spline;

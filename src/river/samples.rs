@@ -1,0 +1,213 @@
+//! Which rivers influence a patch (6.3) and their samples at the patch's level of detail (6.4), in the patch's
+//! frame: the face plane, relative to the patch corner, scaled by the radius, so that vertex (i, j) sits at
+//! `(i, j) * spacing` as the kernel expects.
+
+use glam::{DVec2, DVec3};
+
+use super::{
+    hull,
+    network::{subdivide, RiverNetwork, RiverSystem, Segment, MAX_DEPTH},
+};
+use crate::{
+    kernel::RiverSample,
+    planet::cube::{self, PatchId},
+};
+
+/// A patch's 2D frame.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchFrame {
+    pub patch: PatchId,
+    pub radius: f64,
+    pub vertices: u32,
+}
+
+impl PatchFrame {
+    pub fn new(patch: PatchId, radius: f64, vertices: u32) -> Self {
+        Self {
+            patch,
+            radius,
+            vertices,
+        }
+    }
+
+    /// World units between neighbouring vertices, in the face plane.
+    pub fn spacing(&self) -> f64 {
+        self.patch.size() / (self.vertices - 1) as f64 * self.radius
+    }
+
+    /// The patch-frame position of a direction (projected onto the patch's face plane).
+    pub fn to_patch(&self, d: DVec3) -> DVec2 {
+        let (_, u, v) = cube::face_of_on(self.patch.face as usize, d);
+        let (u0, v0) = self.patch.origin();
+        DVec2::new(u - u0, v - v0) * self.radius
+    }
+
+    /// The patch's outline in a river frame, or `None` if it is not in the frame's hemisphere.
+    fn outline_in(&self, system: &RiverSystem) -> Option<Vec<DVec2>> {
+        let [a, b, c, d] = self.patch.corners();
+        // Counter-clockwise: (0,0), (1,0), (1,1), (0,1).
+        [a, b, d, c]
+            .iter()
+            .map(|p| system.frame.to_plane(*p))
+            .collect()
+    }
+
+    /// Angular radius of the patch around its centre.
+    fn cap_angle(&self) -> f64 {
+        let centre = self.patch.center();
+        self.patch
+            .corners()
+            .iter()
+            .map(|c| c.angle_between(centre))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Section 6.3: whether `system`'s extended hull meets the patch.
+pub fn influences(system: &RiverSystem, frame: &PatchFrame) -> bool {
+    if system.frame.centre.angle_between(frame.patch.center())
+        > system.cap_angle + frame.cap_angle()
+    {
+        return false;
+    }
+    frame
+        .outline_in(system)
+        .is_some_and(|outline| hull::intersects(&system.extended, &outline))
+}
+
+/// The systems that influence a patch.
+pub fn influencing<'a>(
+    network: &'a RiverNetwork,
+    frame: &'a PatchFrame,
+) -> impl Iterator<Item = &'a RiverSystem> {
+    network.systems.iter().filter(move |s| influences(s, frame))
+}
+
+/// Section 6.4: the samples of every river influencing the patch, with each river brought to the patch's level
+/// of detail: pieces are subdivided until their control polygon is at most four vertex spacings long. Samples
+/// lie at most `width / (2 x samples-per-half-width)` apart along each piece (measured in the patch frame), and
+/// only samples that can reach the patch are kept.
+pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> Vec<RiverSample> {
+    let mut out = Vec::new();
+    for system in influencing(network, frame) {
+        let Some(outline) = frame.outline_in(system) else {
+            continue;
+        };
+        let target = 4.0 * frame.spacing();
+        // A sample matters if it is within reach of the patch; the factor 2 covers the face plane's stretch.
+        let reach = 2.0 * network.influence_distance;
+        let mut stack: Vec<Segment> = system.segments.iter().rev().copied().collect();
+        while let Some(piece) = stack.pop() {
+            let control = piece.curve.control_points();
+            let centre = (control[0] + control[1] + control[2] + control[3]) / 4.0;
+            let spread = control
+                .iter()
+                .map(|c| c.distance(centre))
+                .fold(0.0, f64::max);
+            let length = piece.polygon_length();
+            let bound = spread
+                + network.params.descendant_margin(length)
+                + piece.widths.0.max(piece.widths.1) as f64;
+            if hull::distance(&outline, centre) > bound + reach {
+                continue;
+            }
+            if length <= target || piece.depth >= MAX_DEPTH {
+                emit(network, system, frame, &outline, &piece, reach, &mut out);
+            } else {
+                let (children, tributary) = subdivide(&piece, &network.params);
+                if let Some(t) = tributary {
+                    stack.push(t);
+                }
+                stack.extend(children.into_iter().rev());
+            }
+        }
+    }
+    out
+}
+
+/// The samples of `piece` within reach of the patch outline.
+fn emit(
+    network: &RiverNetwork,
+    system: &RiverSystem,
+    frame: &PatchFrame,
+    outline: &[DVec2],
+    piece: &Segment,
+    reach: f64,
+    out: &mut Vec<RiverSample>,
+) {
+    out.extend(
+        piece_samples(network, system, frame, piece)
+            .filter(|(p, s)| hull::distance(outline, *p) <= reach + s.width as f64)
+            .map(|(_, s)| s),
+    );
+}
+
+/// Samples of one piece over t in [0, 1) (the next piece starts where this one ends), each with its river-frame
+/// position. Spacing: half the prescribed `width / (2 x samples-per-half-width)` in the river frame, because the
+/// patch frame can stretch up to 1.8 times more along the flow than across it.
+pub fn piece_samples<'a>(
+    network: &'a RiverNetwork,
+    system: &'a RiverSystem,
+    frame: &'a PatchFrame,
+    piece: &'a Segment,
+) -> impl Iterator<Item = (DVec2, RiverSample)> + 'a {
+    let per_half_width = network.samples_per_half_width as f64;
+    let transform = move |p: DVec2| frame.to_patch(system.frame.to_sphere(p));
+    let h = 1e-3 * network.influence_distance;
+    let mut t = 0.0;
+    std::iter::from_fn(move || {
+        if t >= 1.0 {
+            return None;
+        }
+        let p = piece.curve.point(t);
+        let d = piece.curve.derivative(t);
+        let width = piece.width_at(t) as f64;
+        let speed = d.length().max(1e-9);
+        // Direction and width through the map from river frame to patch frame, by central differences.
+        let along = d / speed;
+        let across = along.perp();
+        let position = transform(p);
+        let derivative = (transform(p + along * h) - transform(p - along * h)) / (2.0 * h) * speed;
+        let stretch = (transform(p + across * h) - transform(p - across * h)).length() / (2.0 * h);
+        let sample = RiverSample::new(
+            position.as_vec2().to_array(),
+            derivative.as_vec2().to_array(),
+            piece.height_at(t),
+            (width * stretch) as f32,
+        );
+        t += (width / (2.0 * per_half_width) * 0.5) / speed;
+        Some((p, sample))
+    })
+}
+
+/// One branch (main river or tributary) of a system as a polyline on the unit sphere.
+#[derive(Clone, Debug)]
+pub struct Branch {
+    pub key: u64,
+    /// The branch this one flows into (`None` for the main river).
+    pub parent: Option<u64>,
+    pub widths: (f32, f32),
+    pub points: Vec<DVec3>,
+}
+
+/// Every branch of a system at `depth`, for drawing and GeoJSON; the main river first.
+pub fn polylines(network: &RiverNetwork, system: &RiverSystem, depth: u32) -> Vec<Branch> {
+    let pieces = super::network::pieces_to_depth(&system.segments, depth, &network.params);
+    let mut lines: Vec<Branch> = Vec::new();
+    for piece in pieces.iter().filter(|p| p.depth == depth) {
+        let points = (0..=8).map(|k| system.frame.to_sphere(piece.curve.point(k as f64 / 8.0)));
+        match lines.iter_mut().find(|l| l.key == piece.branch) {
+            Some(line) => {
+                line.widths.1 = piece.widths.1;
+                line.points.extend(points.skip(1));
+            }
+            None => lines.push(Branch {
+                key: piece.branch,
+                parent: piece.parent_branch,
+                widths: piece.widths,
+                points: points.collect(),
+            }),
+        }
+    }
+    lines
+}

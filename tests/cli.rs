@@ -1,0 +1,101 @@
+//! The command line as a user runs it.
+
+use std::process::Command;
+
+fn riverplanet() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_riverplanet"))
+}
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("riverplanet-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn generate_writes_faces_layout_stats_rivers_and_preview() {
+    let dir = temp_dir("generate");
+    let config = dir.join("small.xml");
+    std::fs::write(
+        &config,
+        "<planet><planet-attributes><base-resolution>65</base-resolution></planet-attributes>\
+         <rendering-attributes><max-level-of-detail>3</max-level-of-detail></rendering-attributes></planet>",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let status = riverplanet()
+        .args(["generate", "--seed", "4", "--preview", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    for face in 0..6 {
+        let image = image::open(out.join(format!("faces/face{face}.png"))).unwrap();
+        assert_eq!((image.width(), image.height()), (257, 257));
+        assert!(
+            matches!(image, image::DynamicImage::ImageLuma16(_)),
+            "16-bit grey"
+        );
+    }
+    let layout: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("faces/layout.json")).unwrap())
+            .unwrap();
+    assert_eq!(layout["faces"].as_array().unwrap().len(), 6);
+    assert_eq!(layout["faces"][0]["size"], serde_json::json!([257, 257]));
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    for key in [
+        "seed",
+        "landmass_percent",
+        "continents",
+        "mountains",
+        "min_height",
+        "max_height",
+        "timings_ms",
+        "memory_bytes",
+        "rivers",
+        "tributaries",
+    ] {
+        assert!(!stats[key].is_null(), "stats.json lacks {key}");
+    }
+    assert_eq!(stats["seed"], 4);
+    let rivers: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("rivers.geojson")).unwrap())
+            .unwrap();
+    assert_eq!(rivers["type"], "FeatureCollection");
+    let features = rivers["features"].as_array().unwrap();
+    assert!(!features.is_empty());
+    for f in features {
+        assert_eq!(f["geometry"]["type"], "LineString");
+        for key in ["id", "width_start", "width_end", "lod"] {
+            assert!(!f["properties"][key].is_null());
+        }
+        for c in f["geometry"]["coordinates"].as_array().unwrap() {
+            let (lon, lat) = (c[0].as_f64().unwrap(), c[1].as_f64().unwrap());
+            assert!((-180.0..=180.0).contains(&lon) && (-90.0..=90.0).contains(&lat));
+        }
+    }
+    assert!(out.join("preview.png").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_configuration_exits_with_2_and_names_the_element() {
+    let dir = temp_dir("config");
+    let config = dir.join("bad.xml");
+    std::fs::write(
+        &config,
+        "<planet><rendering-attributes><vertices>32</vertices></rendering-attributes></planet>",
+    )
+    .unwrap();
+    let output = riverplanet().arg("config").arg(&config).output().unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("<vertices>") && stderr.contains("2^n+1"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
