@@ -12,6 +12,7 @@ pub mod kernel;
 pub mod planet;
 pub mod river;
 pub mod rng;
+pub mod runtime;
 
 /// SPIR-V of every shader in `glsl/`, compiled by build.rs.
 pub mod shaders {

@@ -1,0 +1,71 @@
+//! The camera: position in world coordinates (planet centre at the origin), orientation, and a reversed-Z
+//! infinite perspective for Vulkan (depth 1 at the near plane, 0 at infinity; clip y pointing down), in f64.
+//! Reversed Z with a 32-bit float depth buffer keeps depth precise from a metre above the ground to orbit.
+
+use glam::{DMat4, DVec3, DVec4};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub position: DVec3,
+    /// Unit view direction.
+    pub forward: DVec3,
+    /// Approximate up (made orthogonal to `forward`).
+    pub up: DVec3,
+    /// Vertical field of view, radians.
+    pub fov_y: f64,
+    pub aspect: f64,
+    pub near: f64,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target`, with up towards the planet's outward normal at the eye.
+    pub fn look_at(eye: DVec3, target: DVec3, fov_y_degrees: f64, aspect: f64, near: f64) -> Self {
+        let forward = (target - eye).normalize();
+        let mut up = eye.normalize_or(DVec3::Y);
+        if up.cross(forward).length() < 1e-6 {
+            up = forward.any_orthonormal_vector();
+        }
+        Self {
+            position: eye,
+            forward,
+            up,
+            fov_y: fov_y_degrees.to_radians(),
+            aspect,
+            near,
+        }
+    }
+
+    /// World -> view (camera at the origin, looking down -Z, right-handed).
+    pub fn view(&self) -> DMat4 {
+        self.rotation() * DMat4::from_translation(-self.position)
+    }
+
+    /// Camera-relative world -> view: the rotation only (for camera-relative rendering).
+    pub fn rotation(&self) -> DMat4 {
+        let f = self.forward.normalize();
+        let s = f.cross(self.up).normalize();
+        let u = s.cross(f);
+        DMat4::from_cols(
+            DVec4::new(s.x, u.x, -f.x, 0.0),
+            DVec4::new(s.y, u.y, -f.y, 0.0),
+            DVec4::new(s.z, u.z, -f.z, 0.0),
+            DVec4::W,
+        )
+    }
+
+    /// View -> clip: reversed-Z, infinite far plane, y down.
+    pub fn projection(&self) -> DMat4 {
+        let f = 1.0 / (self.fov_y * 0.5).tan();
+        DMat4::from_cols(
+            DVec4::new(f / self.aspect, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, -f, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, 0.0, -1.0),
+            DVec4::new(0.0, 0.0, self.near, 0.0),
+        )
+    }
+
+    /// World -> clip.
+    pub fn clip(&self) -> DMat4 {
+        self.projection() * self.view()
+    }
+}

@@ -1,0 +1,94 @@
+//! Discarding patches the camera cannot see (Section 6.2.2): those beyond the horizon (the thesis's back-facing
+//! test, made conservative for terrain height) and those outside the view frustum. Both tests bound every point
+//! a patch can place on screen (terrain included), so no patch with a visible pixel is culled.
+
+use glam::{DMat4, DVec3, DVec4};
+
+use crate::planet::cube::PatchId;
+
+/// The six planes of a view frustum, inward normals, as (normal, distance): inside when `n . p + d >= 0`.
+#[derive(Clone, Copy, Debug)]
+pub struct Frustum {
+    planes: [DVec4; 6],
+}
+
+impl Frustum {
+    /// From a world-to-clip matrix with depth in [0, 1] (Vulkan). A plane at infinity (the far plane of an
+    /// infinite projection) has no normal and never culls.
+    pub fn from_matrix(m: DMat4) -> Self {
+        let r = |i: usize| m.row(i);
+        let planes = [
+            r(3) + r(0),
+            r(3) - r(0),
+            r(3) + r(1),
+            r(3) - r(1),
+            r(2),
+            r(3) - r(2),
+        ]
+        .map(|p| {
+            let length = p.truncate().length();
+            if length > 1e-12 {
+                p / length
+            } else {
+                DVec4::new(0.0, 0.0, 0.0, 1.0)
+            }
+        });
+        Self { planes }
+    }
+
+    /// Whether a sphere touches the frustum.
+    pub fn touches_sphere(&self, centre: DVec3, radius: f64) -> bool {
+        self.planes
+            .iter()
+            .all(|p| p.truncate().dot(centre) + p.w >= -radius)
+    }
+}
+
+/// Heights every point of the planet lies between (base terrain and rivers).
+#[derive(Clone, Copy, Debug)]
+pub struct HeightRange {
+    pub min: f64,
+    pub max: f64,
+}
+
+/// A sphere containing every point of a patch between the heights of `range` (with the sphere's bulge between
+/// sample points covered by sampling a 5x5 grid and a margin of a tenth of the grid step's chord).
+pub fn bounding_sphere(patch: PatchId, radius: f64, range: HeightRange) -> (DVec3, f64) {
+    let centre_dir = patch.center();
+    let centre = centre_dir * (radius + 0.5 * (range.min + range.max));
+    let mut r: f64 = 0.0;
+    for j in 0..=4 {
+        for i in 0..=4 {
+            let d = patch.sphere_point(i as f64 / 4.0, j as f64 / 4.0);
+            for h in [range.min, range.max] {
+                r = r.max(centre.distance(d * (radius + h)));
+            }
+        }
+    }
+    let step = patch
+        .sphere_point(0.0, 0.0)
+        .distance(patch.sphere_point(0.25, 0.25))
+        * (radius + range.max);
+    (centre, r + 0.1 * step + 1e-3)
+}
+
+/// Whether the whole patch is hidden behind the planet: every point of it (up to the highest terrain) lies
+/// beyond the horizon of the lowest terrain. Conservative on a sphere: the angle from the camera direction to the
+/// nearest point of the patch exceeds the horizon angle of the camera plus that of the highest point.
+pub fn beyond_horizon(patch: PatchId, camera: DVec3, radius: f64, range: HeightRange) -> bool {
+    let low = radius + range.min;
+    let high = radius + range.max;
+    let distance = camera.length();
+    if distance <= low {
+        return false;
+    }
+    let centre = patch.center();
+    let spread = patch
+        .corners()
+        .iter()
+        .map(|c| c.angle_between(centre))
+        .fold(0.0, f64::max);
+    let nearest = (centre.angle_between(camera) - spread).max(0.0);
+    let horizon = (low / distance).acos() + (low / high).min(1.0).acos();
+    nearest > horizon
+}
