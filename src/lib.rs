@@ -1,8 +1,13 @@
 //! riverplanet: a Vulkan planet renderer that generates river networks on procedural planets in real time,
 //! after Kurz, *Parallel River Networks* (TU Graz 2020).
 //!
-//! Layers, dependencies pointing down: `kernel` (the river-height kernel: CPU reference and GPU dispatch),
-//! `config` (the XML of Table 6.1 / Appendix A), `gpu` (the only module that imports ash).
+//! Layers, dependencies pointing down (docs/architecture.md):
+//! - app: `world` (planet + rivers from a configuration), `bench`, `export`, and the `riverplanet` binary;
+//! - `render`: the frame loop, terrain and water pipelines, offscreen targets, the viewer;
+//! - `runtime`: level of detail, culling, camera, patch cache;
+//! - `kernel`: the river-height kernel (CPU reference and GPU dispatch);
+//! - model: `planet`, `river`, `config`, `rng`;
+//! - `gpu`: the only module that imports ash; it knows nothing of planets.
 
 pub mod bench;
 pub mod config;
@@ -10,9 +15,11 @@ pub mod export;
 pub mod gpu;
 pub mod kernel;
 pub mod planet;
+pub mod render;
 pub mod river;
 pub mod rng;
 pub mod runtime;
+pub mod world;
 
 /// SPIR-V of every shader in `glsl/`, compiled by build.rs.
 pub mod shaders {

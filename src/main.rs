@@ -8,6 +8,7 @@ use riverplanet::{
     config::Config,
     gpu::{self, Context, ContextOptions},
     kernel::gpu::KernelTuning,
+    render::{ViewMode, WaterMode},
 };
 
 #[derive(Parser)]
@@ -51,11 +52,49 @@ enum Command {
         #[arg(long)]
         equirect: bool,
     },
+    /// Render one image headless (no display, no window system) and print per-pass GPU times.
+    Render(RenderArgs),
     /// Measure the river kernel variants side by side in one run.
     Bench {
         #[command(subcommand)]
         what: BenchCommand,
     },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    #[arg(long, default_value = "config/planet.xml")]
+    config: PathBuf,
+    /// Override master-seed.
+    #[arg(long)]
+    seed: Option<u32>,
+    /// Camera position, world units with the planet centre at the origin.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1200,3400")]
+    eye: glam::DVec3,
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0")]
+    look_at: glam::DVec3,
+    /// Place the camera from the planet's own features instead of --eye/--look-at: `orbit` (the first river's
+    /// side of the planet), `mountains` (above the first river's source), `river` (close above the first river).
+    #[arg(long, value_enum)]
+    preset: Option<riverplanet::render::presets::Preset>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 45.0)]
+    fov: f64,
+    #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+    size: [u32; 2],
+    #[arg(long, value_enum, default_value = "auto")]
+    water: WaterMode,
+    #[arg(long, value_enum, default_value = "shaded")]
+    view: ViewMode,
+    #[arg(long, value_enum, default_value = "tiled")]
+    kernel: riverplanet::kernel::gpu::KernelVariant,
+    #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06")]
+    clear_color: glam::DVec3,
+    /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
+    #[arg(long, default_value_t = 200)]
+    max_frames: u32,
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -101,6 +140,13 @@ fn main() -> ExitCode {
             preview,
             equirect,
         } => match generate(&config, &out, seed, preview, equirect) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::Render(args) => match render(&options, &args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e:#}");
@@ -341,6 +387,125 @@ fn generate(
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
+    }
+    Ok(())
+}
+
+fn parse_vec3(text: &str) -> Result<glam::DVec3, String> {
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{text}' is not three comma-separated numbers (e.g. 0,1200,3400)"))?;
+    match parts.as_slice() {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok(glam::DVec3::new(*x, *y, *z)),
+        _ => Err(format!(
+            "'{text}' is not three comma-separated numbers (e.g. 0,1200,3400)"
+        )),
+    }
+}
+
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let [w, h] = parse_block(text)?;
+    if (1..=16384).contains(&w) && (1..=16384).contains(&h) {
+        Ok([w, h])
+    } else {
+        Err(format!("size '{text}' must be WxH with both in [1, 16384]"))
+    }
+}
+
+fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
+    let config = load_config(&args.config)?;
+    let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
+    if args.eye.length() <= config.planet.radius as f64 * 0.5 {
+        anyhow::bail!(
+            "--eye {} is inside the planet (radius {})",
+            args.eye,
+            config.planet.radius
+        );
+    }
+    if (args.look_at - args.eye).length() < 1e-9 {
+        anyhow::bail!("--look-at must differ from --eye");
+    }
+    if !(1.0..=170.0).contains(&args.fov) {
+        anyhow::bail!("--fov {} must be in [1, 170] degrees", args.fov);
+    }
+    let world = riverplanet::world::World::build(&config, seed)?;
+    let (eye, look_at) = match args.preset {
+        Some(preset) => riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
+            anyhow::anyhow!("preset {preset:?} needs a river, and this planet has none")
+        })?,
+        None => (args.eye, args.look_at),
+    };
+    println!(
+        "camera: --eye {},{},{} --look-at {},{},{}",
+        eye.x, eye.y, eye.z, look_at.x, look_at.y, look_at.z
+    );
+    let ctx = Context::new(options)?;
+    let [w, h] = args.size;
+    let target = riverplanet::render::target::Offscreen::new(&ctx, w, h)?;
+    let mut renderer = riverplanet::render::Renderer::new(
+        &ctx,
+        &world.planet,
+        &world.network,
+        &config,
+        riverplanet::render::target::COLOR_FORMAT,
+        riverplanet::render::target::DEPTH_FORMAT,
+    )?;
+    renderer.water_mode = args.water;
+    renderer.view_mode = args.view;
+    renderer.variant = args.kernel;
+    let altitude = eye.length() - config.planet.radius as f64;
+    let camera = riverplanet::runtime::camera::Camera::look_at(
+        eye,
+        look_at,
+        args.fov,
+        w as f64 / h as f64,
+        (altitude * 0.05).clamp(0.01, 10.0),
+    );
+    let c = args.clear_color;
+    let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
+    let mut layout = gpu::vk::ImageLayout::UNDEFINED;
+    let mut frames = 0;
+    let stats = loop {
+        let stats = renderer.render(
+            &camera,
+            &target.target(clear),
+            (layout, gpu::vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+            &[],
+            &[],
+        )?;
+        layout = gpu::vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        frames += 1;
+        if (stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0)
+            || frames >= args.max_frames
+        {
+            break stats;
+        }
+    };
+    let image = target.read(&ctx)?;
+    image
+        .save(&args.out)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", args.out.display()))?;
+    println!(
+        "{}: {w}x{h}, {frames} frames to stream the patches; last frame: {} visible patches, {} resident",
+        args.out.display(),
+        stats.visible_patches,
+        stats.resident_patches
+    );
+    for (pass, ms) in &stats.gpu_ms {
+        println!("  gpu {pass:<8} {ms:8.3} ms");
+    }
+    println!("  frame     {:8.3} ms", stats.frame_ms);
+    let errors = ctx.validation_errors();
+    renderer.destroy();
+    target.destroy(&ctx);
+    if !errors.is_empty() {
+        anyhow::bail!(
+            "validation reported {} error(s): {}",
+            errors.len(),
+            errors[0]
+        );
     }
     Ok(())
 }

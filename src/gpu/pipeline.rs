@@ -171,3 +171,286 @@ impl Recorder<'_> {
         }
     }
 }
+
+/// What a graphics pipeline of the terrain renderer needs: vertex, geometry and fragment shaders, dynamic
+/// rendering into one colour and one depth attachment, and a few fixed-function choices.
+pub struct GraphicsDesc<'a> {
+    pub name: &'a str,
+    pub vertex: &'a [u8],
+    pub geometry: Option<&'a [u8]>,
+    pub fragment: &'a [u8],
+    pub set_layouts: &'a [vk::DescriptorSetLayout],
+    pub push_constant_bytes: u32,
+    /// `u32` specialization constants given to every stage (constant_id 0, 1, ...).
+    pub specialization: &'a [u32],
+    pub color_format: vk::Format,
+    pub depth_format: vk::Format,
+    pub depth_write: bool,
+    /// Depth test: GREATER (reversed Z).
+    pub depth_test: bool,
+    pub alpha_blend: bool,
+    pub wireframe: bool,
+}
+
+/// A graphics pipeline and its layout.
+pub struct GraphicsPipeline {
+    pub pipeline: vk::Pipeline,
+    pub layout: vk::PipelineLayout,
+}
+
+impl GraphicsPipeline {
+    pub fn new(ctx: &Context, desc: &GraphicsDesc) -> Result<Self, GpuError> {
+        let stages_all = vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::GEOMETRY
+            | vk::ShaderStageFlags::FRAGMENT;
+        let ranges = [vk::PushConstantRange::default()
+            .stage_flags(stages_all)
+            .size(desc.push_constant_bytes)];
+        let layout_info = vk::PipelineLayoutCreateInfo::default()
+            .set_layouts(desc.set_layouts)
+            .push_constant_ranges(if desc.push_constant_bytes > 0 {
+                &ranges
+            } else {
+                &[]
+            });
+        // SAFETY: valid create info.
+        let layout = unsafe { ctx.device.create_pipeline_layout(&layout_info, None) }
+            .vk("vkCreatePipelineLayout")?;
+        let mut modules = Vec::new();
+        let mut make = |spirv: &[u8], stage: &str| -> Result<vk::ShaderModule, GpuError> {
+            let m = shader_module(ctx, spirv, &format!("{} {stage}", desc.name))?;
+            modules.push(m);
+            Ok(m)
+        };
+        let result = (|| {
+            let vertex = make(desc.vertex, "vertex")?;
+            let geometry = desc.geometry.map(|g| make(g, "geometry")).transpose()?;
+            let fragment = make(desc.fragment, "fragment")?;
+            let entries: Vec<_> = (0..desc.specialization.len() as u32)
+                .map(|i| vk::SpecializationMapEntry {
+                    constant_id: i,
+                    offset: i * 4,
+                    size: 4,
+                })
+                .collect();
+            let spec = vk::SpecializationInfo::default()
+                .map_entries(&entries)
+                .data(bytemuck::cast_slice(desc.specialization));
+            let stage = |s: vk::ShaderStageFlags, m: vk::ShaderModule| {
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(s)
+                    .module(m)
+                    .name(c"main")
+                    .specialization_info(&spec)
+            };
+            let mut stages = vec![stage(vk::ShaderStageFlags::VERTEX, vertex)];
+            if let Some(g) = geometry {
+                stages.push(stage(vk::ShaderStageFlags::GEOMETRY, g));
+            }
+            stages.push(stage(vk::ShaderStageFlags::FRAGMENT, fragment));
+            let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+            let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+                .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+            let viewport = vk::PipelineViewportStateCreateInfo::default()
+                .viewport_count(1)
+                .scissor_count(1);
+            let raster = vk::PipelineRasterizationStateCreateInfo::default()
+                .polygon_mode(if desc.wireframe {
+                    vk::PolygonMode::LINE
+                } else {
+                    vk::PolygonMode::FILL
+                })
+                .cull_mode(vk::CullModeFlags::NONE)
+                .line_width(1.0);
+            let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+                .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+            let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+                .depth_test_enable(desc.depth_test)
+                .depth_write_enable(desc.depth_write)
+                .depth_compare_op(vk::CompareOp::GREATER_OR_EQUAL);
+            let blend_attachment = [if desc.alpha_blend {
+                vk::PipelineColorBlendAttachmentState::default()
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ZERO)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .alpha_blend_op(vk::BlendOp::ADD)
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            } else {
+                vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            }];
+            let blend =
+                vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachment);
+            let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+            let dynamic =
+                vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+            let color_formats = [desc.color_format];
+            let mut rendering = vk::PipelineRenderingCreateInfo::default()
+                .color_attachment_formats(&color_formats)
+                .depth_attachment_format(desc.depth_format);
+            let info = [vk::GraphicsPipelineCreateInfo::default()
+                .stages(&stages)
+                .vertex_input_state(&vertex_input)
+                .input_assembly_state(&assembly)
+                .viewport_state(&viewport)
+                .rasterization_state(&raster)
+                .multisample_state(&multisample)
+                .depth_stencil_state(&depth)
+                .color_blend_state(&blend)
+                .dynamic_state(&dynamic)
+                .layout(layout)
+                .push_next(&mut rendering)];
+            // SAFETY: every pointer in `info` lives until the call returns.
+            unsafe {
+                ctx.device
+                    .create_graphics_pipelines(vk::PipelineCache::null(), &info, None)
+            }
+            .map(|p| p[0])
+            .map_err(|(_, e)| GpuError::Vk {
+                call: "vkCreateGraphicsPipelines",
+                result: e,
+            })
+        })();
+        for m in modules {
+            // SAFETY: modules are not needed after pipeline creation.
+            unsafe { ctx.device.destroy_shader_module(m, None) };
+        }
+        match result {
+            Ok(pipeline) => {
+                ctx.set_name(pipeline, desc.name);
+                Ok(Self { pipeline, layout })
+            }
+            Err(e) => {
+                unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+                Err(e)
+            }
+        }
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        // SAFETY: called after all work using the pipeline completed.
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}
+
+/// The attachments of one rendering pass (raw handles, so that swapchain images can be targets too).
+#[derive(Clone, Copy, Debug)]
+pub struct RenderTarget {
+    pub color_image: vk::Image,
+    pub color_view: vk::ImageView,
+    pub depth_image: vk::Image,
+    pub depth_view: vk::ImageView,
+    pub extent: vk::Extent2D,
+    pub clear_color: [f32; 4],
+}
+
+impl Recorder<'_> {
+    /// Begins dynamic rendering into `target` (colour in COLOR_ATTACHMENT_OPTIMAL, depth in
+    /// DEPTH_ATTACHMENT_OPTIMAL), clearing both when `clear` (depth to 0: reversed Z), and sets viewport and scissor.
+    pub fn begin_rendering(&mut self, target: &RenderTarget, clear: bool) {
+        let extent = target.extent;
+        let load = if clear {
+            vk::AttachmentLoadOp::CLEAR
+        } else {
+            vk::AttachmentLoadOp::LOAD
+        };
+        let color = [vk::RenderingAttachmentInfo::default()
+            .image_view(target.color_view)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                color: vk::ClearColorValue {
+                    float32: target.clear_color,
+                },
+            })];
+        let depth = vk::RenderingAttachmentInfo::default()
+            .image_view(target.depth_view)
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 0.0,
+                    stencil: 0,
+                },
+            });
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent,
+            })
+            .layer_count(1)
+            .color_attachments(&color)
+            .depth_attachment(&depth);
+        let device = &self.ctx().device;
+        // SAFETY: recording; attachments are in the stated layouts (caller's contract).
+        unsafe {
+            device.cmd_begin_rendering(self.cmd, &info);
+            device.cmd_set_viewport(
+                self.cmd,
+                0,
+                &[vk::Viewport {
+                    x: 0.0,
+                    y: 0.0,
+                    width: extent.width as f32,
+                    height: extent.height as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                }],
+            );
+            device.cmd_set_scissor(
+                self.cmd,
+                0,
+                &[vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                }],
+            );
+        }
+    }
+
+    pub fn end_rendering(&mut self) {
+        // SAFETY: paired with begin_rendering.
+        unsafe { self.ctx().device.cmd_end_rendering(self.cmd) };
+    }
+
+    /// Draws `instances` instances of the indexed mesh in `indices` (u32) with `pipeline`.
+    pub fn draw_indexed(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        sets: &[vk::DescriptorSet],
+        push: &[u8],
+        indices: &super::Buffer,
+        index_count: u32,
+        instances: u32,
+    ) {
+        let device = &self.ctx().device;
+        let stages = vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::GEOMETRY
+            | vk::ShaderStageFlags::FRAGMENT;
+        // SAFETY: recording inside a rendering scope; sets match the layout (validated by the layer).
+        unsafe {
+            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
+            device.cmd_bind_descriptor_sets(
+                self.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                pipeline.layout,
+                0,
+                sets,
+                &[],
+            );
+            if !push.is_empty() {
+                device.cmd_push_constants(self.cmd, pipeline.layout, stages, 0, push);
+            }
+            device.cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32);
+            device.cmd_draw_indexed(self.cmd, index_count, instances, 0, 0, 0);
+        }
+    }
+}

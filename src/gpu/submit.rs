@@ -375,6 +375,36 @@ impl<'a> Recorder<'a> {
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
+    /// Transitions one raw image (e.g. a swapchain image) between layouts.
+    #[allow(clippy::too_many_arguments)]
+    pub fn raw_image_transition(
+        &mut self,
+        image: vk::Image,
+        aspect: vk::ImageAspectFlags,
+        old: vk::ImageLayout,
+        new: vk::ImageLayout,
+        src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+        dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    ) {
+        let barrier = [vk::ImageMemoryBarrier2::default()
+            .image(image)
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(aspect)
+                    .level_count(1)
+                    .layer_count(1),
+            )
+            .old_layout(old)
+            .new_layout(new)
+            .src_stage_mask(src.0)
+            .src_access_mask(src.1)
+            .dst_stage_mask(dst.0)
+            .dst_access_mask(dst.1)];
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barrier);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
     /// Ends recording and submits; `waits`/`signals` are binary semaphores (swapchain acquire/present).
     pub fn submit_with(
         self,

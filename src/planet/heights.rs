@@ -199,6 +199,38 @@ impl FaceLattice {
         }
     }
 
+    /// The `(n + 2) x (n + 2)` heights of a patch with a one-vertex border taken from the neighbouring patches (on
+    /// this face or, across a face border, on the adjacent face), so that normals at patch edges see the same
+    /// neighbours on both sides. At a cube corner the missing diagonal neighbour repeats the nearest border value.
+    pub fn patch_with_border(&self, face: usize, level: u32, x: u32, y: u32, n: u32) -> Vec<f32> {
+        let span = self.cells >> level;
+        let stride = (span / (n - 1)) as i64;
+        let c = self.cells as i64;
+        let normal = axis(FACE_AXES[face].0);
+        let (x0, y0) = ((x * span) as i64, (y * span) as i64);
+        let mut out = Vec::with_capacity(((n + 2) * (n + 2)) as usize);
+        for j in -1..=n as i64 {
+            for i in -1..=n as i64 {
+                let (gi, gj) = (x0 + i * stride, y0 + j * stride);
+                let inside = |g: i64| (0..=c).contains(&g);
+                let h = if inside(gi) && inside(gj) {
+                    self.get(face, gi as u32, gj as u32)
+                } else {
+                    // Step from the nearest border point into the adjacent face (against this face's normal).
+                    let (ci, cj) = (gi.clamp(0, c), gj.clamp(0, c));
+                    let over = (gi - ci).abs().max((gj - cj).abs());
+                    if (gi - ci) != 0 && (gj - cj) != 0 {
+                        self.get(face, ci as u32, cj as u32)
+                    } else {
+                        self.at_key(self.key(face, ci as u32, cj as u32) - normal * over)
+                    }
+                };
+                out.push(h);
+            }
+        }
+        out
+    }
+
     /// The `n x n` heights of a patch at `level`, where a patch at level L spans `cells / 2^L` cells.
     pub fn patch(&self, face: usize, level: u32, x: u32, y: u32, n: u32) -> Vec<f32> {
         let span = self.cells >> level;

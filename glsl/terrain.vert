@@ -1,0 +1,85 @@
+#version 460
+// Section 8.2: per vertex, the base height and the river data of the patch, blended by the lerp factor, projected
+// onto the sphere; normals from neighbouring heights; skirts below the patch edges close cracks between levels.
+#include "terrain_common.glsl"
+
+layout(location = 0) out vec3 vPosition;    // camera-relative
+layout(location = 1) out vec3 vNormal;
+layout(location = 2) out vec3 vDirection;   // unit direction from the planet centre
+layout(location = 3) out vec4 vRiver;       // final height, water height, signed distance, river half width
+layout(location = 4) out vec2 vGrid;        // (i, j) within the patch
+layout(location = 5) flat out int vInstance;
+
+const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
+const vec3 FACE_U[6] = vec3[](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0), vec3(1, 0, 0), vec3(1, 0, 0), vec3(-1, 0, 0));
+const vec3 FACE_V[6] = vec3[](vec3(0, 1, 0), vec3(0, 1, 0), vec3(0, 0, -1), vec3(0, 0, 1), vec3(0, 1, 0), vec3(0, 1, 0));
+
+vec3 directionAt(PatchInstance p, vec2 grid) {
+    float n = frame.planet.y;
+    vec2 uv = p.uvRect.xy + grid / (n - 1.0) * p.uvRect.z;
+    int face = int(p.uvRect.w);
+    return normalize(FACE_NORMAL[face] + uv.x * FACE_U[face] + uv.y * FACE_V[face]);
+}
+
+// River data and base height at a grid position, read from the patch's (or its stand-in's) textures.
+vec4 surfaceAt(PatchInstance p, vec2 grid, out float baseHeight) {
+    float n = frame.planet.y;
+    vec2 t = p.texRect.xy + grid * p.texRect.z;
+    baseHeight = textureLod(patchTextures[nonuniformEXT(p.slots.x)], vec3((t + 1.5) / (n + 2.0), 0.0), 0.0).r;
+    if (p.slots.y < 0) return vec4(baseHeight, frame.sun.w, 1e9, 0.0);
+    vec2 uv = (t + 0.5) / n;
+    vec4 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3(uv, 0.0), 0.0);
+    float halfWidth = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3(uv, 1.0), 0.0).r;
+    // Section 8.2: blend the river terrain into the base terrain by the lerp factor.
+    float height = mix(river.x, baseHeight, river.y);
+    return vec4(height, max(river.z, frame.sun.w), river.w, halfWidth);
+}
+
+vec3 positionAt(PatchInstance p, vec2 grid, float height, vec3 direction) {
+    float radius = frame.planet.x;
+    // Relative to the patch centre first, so that no large coordinate reaches the rasteriser.
+    return p.centreRel.xyz + (direction - p.centreDir.xyz) * radius + direction * height;
+}
+
+void main() {
+    PatchInstance p = instances[gl_InstanceIndex];
+    int n = int(frame.planet.y);
+    int id = gl_VertexIndex;
+    bool skirt = id >= n * n;
+    ivec2 ij;
+    if (!skirt) {
+        ij = ivec2(id % n, id / n);
+    } else {
+        int e = (id - n * n) / n;
+        int k = (id - n * n) % n;
+        ij = e == 0 ? ivec2(k, 0) : e == 1 ? ivec2(k, n - 1) : e == 2 ? ivec2(0, k) : ivec2(n - 1, k);
+    }
+    vec2 grid = vec2(ij);
+    float base;
+    vec4 surface = surfaceAt(p, grid, base);
+    vec3 direction = directionAt(p, grid);
+    float height = surface.x;
+    if (skirt) height -= frame.extra.x * p.centreDir.w;
+    vec3 position = positionAt(p, grid, height, direction);
+
+    // Normal from the four neighbours (clamped to the patch; the base texture's border keeps edges smooth).
+    vec3 neighbour[4];
+    vec2 offsets[4] = vec2[](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1));
+    for (int k = 0; k < 4; ++k) {
+        vec2 g = clamp(grid + offsets[k], vec2(0.0), vec2(n - 1));
+        float b;
+        vec4 s = surfaceAt(p, g, b);
+        vec3 d = directionAt(p, g);
+        neighbour[k] = positionAt(p, g, s.x, d);
+    }
+    vec3 normal = normalize(cross(neighbour[0] - neighbour[1], neighbour[2] - neighbour[3]));
+    if (dot(normal, direction) < 0.0) normal = -normal;
+
+    vPosition = position;
+    vNormal = normal;
+    vDirection = direction;
+    vRiver = vec4(height, surface.y, surface.z, surface.w);
+    vGrid = grid;
+    vInstance = gl_InstanceIndex;
+    gl_Position = frame.viewProjection * vec4(position, 1.0);
+}

@@ -1,0 +1,33 @@
+// Shared by terrain.vert, terrain.geom and terrain.frag (Chapter 8): per-frame push constants, the per-patch
+// instance table, and the bindless patch textures.
+#extension GL_EXT_nonuniform_qualifier : require
+
+layout(push_constant) uniform FramePush {
+    // Camera-relative world -> clip (the camera sits at the origin; see docs/rendering.md).
+    mat4 viewProjection;
+    // xyz: unit direction towards the sun; w: sea level.
+    vec4 sun;
+    // x: radius; y: vertices per patch edge; z: water mode (0 auto, 1 geometry, 2 painted); w: view (0 shaded,
+    // 1 level-of-detail colours, 2 painted rivers shown red).
+    vec4 planet;
+    // x: skirt depth in vertex spacings; y: time; zw: unused.
+    vec4 extra;
+} frame;
+
+const uint WATER_AUTO = 0;
+const uint WATER_GEOMETRY = 1;
+const uint WATER_PAINTED = 2;
+
+// One drawn patch (or the part of an ancestor standing in for a patch whose data has not arrived).
+struct PatchInstance {
+    vec4 centreRel;  // xyz: radius * centre direction - camera; w: level
+    vec4 centreDir;  // xyz: unit centre direction; w: world distance between neighbouring vertices
+    vec4 uvRect;     // xy: face (u, v) of vertex (0, 0); z: (u, v) size; w: face
+    vec4 texRect;    // xy: source texel of vertex (0, 0); z: source texels per vertex; w: unused
+    ivec4 slots;     // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: unused
+};
+
+layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance instances[]; };
+
+// Every patch texture is a 2D array view: base heights (1 layer, with a one-texel border), river data (2 layers).
+layout(set = 0, binding = 1) uniform sampler2DArray patchTextures[];

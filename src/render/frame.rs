@@ -1,0 +1,687 @@
+//! One frame (docs/rendering.md): level of detail, culling, river data for new patches (one kernel dispatch),
+//! then one instanced draw of all visible patches for the terrain and one for the water, each timed.
+
+use std::{collections::BTreeMap, time::Instant};
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::mesh::patch_indices;
+use crate::{
+    config::Config,
+    gpu::{
+        bindless::{Bindless, Slot},
+        pipeline::{BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
+        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler,
+        Recorder,
+    },
+    kernel::{
+        gpu::{create_river_texture, GpuPatchJob, KernelTuning, KernelVariant, RiverKernel},
+        KernelParams, RiverSample,
+    },
+    planet::{cube::PatchId, Planet},
+    river::{
+        network::RiverNetwork,
+        samples::{patch_samples, PatchFrame},
+    },
+    runtime::{
+        cache::{PatchCache, PatchData},
+        camera::Camera,
+        cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
+        lod::{select, LodParams, Selected},
+    },
+    shaders,
+};
+
+/// How rivers are drawn (Section 8.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum WaterMode {
+    /// The thesis's rule: water geometry where the mesh resolves the river, painted elsewhere.
+    Auto,
+    /// Always emit water triangles in river basins.
+    Geometry,
+    /// Always paint rivers in the fragment shader (sea water stays geometry).
+    Painted,
+}
+
+impl WaterMode {
+    pub fn next(self) -> Self {
+        match self {
+            WaterMode::Auto => WaterMode::Geometry,
+            WaterMode::Geometry => WaterMode::Painted,
+            WaterMode::Painted => WaterMode::Auto,
+        }
+    }
+}
+
+/// What the fragment shader shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ViewMode {
+    Shaded,
+    /// Patches tinted by level of detail.
+    Lod,
+    /// Painted rivers in red (as in the thesis's Fig. 9.9).
+    PaintedRed,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct FramePush {
+    view_projection: [[f32; 4]; 4],
+    sun: [f32; 4],
+    planet: [f32; 4],
+    extra: [f32; 4],
+}
+
+/// std430 mirror of `PatchInstance` in glsl/terrain_common.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PatchInstance {
+    centre_rel: [f32; 4],
+    centre_dir: [f32; 4],
+    uv_rect: [f32; 4],
+    tex_rect: [f32; 4],
+    slots: [i32; 4],
+}
+
+/// What one frame did, for the viewer, the benchmarks and the plots (Chapter 9).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FrameStats {
+    pub frame: u64,
+    /// Patches selected by the level of detail (before culling).
+    pub selected_patches: usize,
+    pub visible_patches: usize,
+    pub new_patches: usize,
+    /// New patches influenced by rivers (computed by the kernel this frame).
+    pub river_patches: usize,
+    /// Visible patches drawn with an ancestor's data because theirs has not arrived yet.
+    pub fallback_patches: usize,
+    /// Patches still waiting for data after this frame.
+    pub pending_patches: usize,
+    pub samples: usize,
+    pub resident_patches: usize,
+    pub evicted_patches: usize,
+    pub patch_texture_bytes: u64,
+    pub temporary_sample_bytes: u64,
+    pub precomputed_height_bytes: u64,
+    pub memory_bytes: u64,
+    pub cpu_ms: BTreeMap<String, f64>,
+    pub gpu_ms: BTreeMap<String, f64>,
+    pub frame_ms: f64,
+}
+
+const BASE_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+fn to_f32(m: DMat4) -> [[f32; 4]; 4] {
+    m.as_mat4().to_cols_array_2d()
+}
+
+/// The renderer of one planet.
+pub struct Renderer<'w> {
+    ctx: &'w Context,
+    planet: &'w Planet,
+    network: &'w RiverNetwork,
+    config: Config,
+    bindless: Bindless,
+    kernel: RiverKernel,
+    terrain: GraphicsPipeline,
+    water: GraphicsPipeline,
+    wireframe: GraphicsPipeline,
+    instance_layout: BufferSetLayout,
+    indices: Buffer,
+    index_count: u32,
+    cache: PatchCache,
+    profiler: Profiler,
+    params: KernelParams,
+    heights: HeightRange,
+    frame: u64,
+    frozen: Option<Vec<Selected>>,
+    pub variant: KernelVariant,
+    pub water_mode: WaterMode,
+    pub view_mode: ViewMode,
+    pub wireframe_on: bool,
+    pub freeze_lod: bool,
+    /// Unit direction towards the sun; `None`: over the camera's shoulder.
+    pub sun: Option<DVec3>,
+}
+
+impl<'w> Renderer<'w> {
+    pub fn new(
+        ctx: &'w Context,
+        planet: &'w Planet,
+        network: &'w RiverNetwork,
+        config: &Config,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+    ) -> Result<Self, GpuError> {
+        let n = config.rendering.vertices;
+        let capacity = config.rendering.max_resident_patches as usize;
+        let bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
+        // Two slots per patch at most; keep the cache within what the bindless arrays hold.
+        let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
+        let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::default())?;
+        let instance_layout = BufferSetLayout::new(ctx, 1, "patch instances")?;
+        let layouts = [bindless.layout, instance_layout.layout];
+        let pipeline = |name: &str, water: bool, wireframe: bool| {
+            GraphicsPipeline::new(
+                ctx,
+                &GraphicsDesc {
+                    name,
+                    vertex: shaders::TERRAIN_VERT,
+                    geometry: Some(shaders::TERRAIN_GEOM),
+                    fragment: shaders::TERRAIN_FRAG,
+                    set_layouts: &layouts,
+                    push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+                    specialization: &[water as u32],
+                    color_format,
+                    depth_format,
+                    depth_write: !water,
+                    depth_test: true,
+                    alpha_blend: water,
+                    wireframe,
+                },
+            )
+        };
+        let terrain = pipeline("terrain", false, false)?;
+        let water = pipeline("water", true, false)?;
+        let wireframe = pipeline("terrain wireframe", false, true)?;
+        let mesh = patch_indices(n);
+        let indices = ctx.create_buffer(&BufferDesc {
+            name: "patch mesh indices",
+            size: (mesh.len() * 4) as u64,
+            usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        ctx.run_and_wait("upload patch mesh", |rec| {
+            rec.upload_buffer(&indices, 0, bytemuck::cast_slice(&mesh))
+        })?;
+        let profiler = Profiler::new(ctx, 8, "frame timestamps")?;
+        let heights = HeightRange {
+            min: planet.stats.min_height as f64 - 1.0,
+            max: planet.stats.max_height as f64 + config.river.basin_depth as f64 + 1.0,
+        };
+        Ok(Self {
+            ctx,
+            planet,
+            network,
+            config: config.clone(),
+            bindless,
+            kernel,
+            terrain,
+            water,
+            wireframe,
+            instance_layout,
+            indices,
+            index_count: mesh.len() as u32,
+            cache: PatchCache::new(capacity),
+            profiler,
+            params: KernelParams::from_config(config),
+            heights,
+            frame: 0,
+            frozen: None,
+            variant: KernelVariant::Tiled,
+            water_mode: WaterMode::Auto,
+            view_mode: ViewMode::Shaded,
+            wireframe_on: false,
+            freeze_lod: false,
+            sun: None,
+        })
+    }
+
+    fn lod_params(&self) -> LodParams {
+        LodParams {
+            radius: self.planet.radius,
+            switch_factor: self.config.rendering.level_of_detail_switch_factor as f64,
+            max_level: self.config.rendering.max_level_of_detail,
+        }
+    }
+
+    /// Renders one frame into `target`, whose colour image is in `color_layouts.0` and is left in
+    /// `color_layouts.1`. `waits` and `signals` are binary semaphores (swapchain). Blocks until the frame is done.
+    pub fn render(
+        &mut self,
+        camera: &Camera,
+        target: &RenderTarget,
+        color_layouts: (vk::ImageLayout, vk::ImageLayout),
+        waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+        signals: &[vk::Semaphore],
+    ) -> Result<FrameStats, GpuError> {
+        let start = Instant::now();
+        let ctx = self.ctx;
+        self.frame += 1;
+        self.cache.next_frame();
+        let mut stats = FrameStats {
+            frame: self.frame,
+            ..Default::default()
+        };
+        let mut cpu = BTreeMap::new();
+        let radius = self.planet.radius;
+        let n = self.config.rendering.vertices;
+
+        // Section 6.2.1: level of detail (or the frozen selection).
+        let t = Instant::now();
+        let selected = match (&self.frozen, self.freeze_lod) {
+            (Some(frozen), true) => frozen.clone(),
+            _ => select(camera.position, &self.lod_params()),
+        };
+        self.frozen = Some(selected.clone());
+        cpu.insert("lod".to_string(), ms_since(t));
+
+        // Section 6.2.2: horizon and frustum culling.
+        let t = Instant::now();
+        let frustum = Frustum::from_matrix(camera.clip());
+        let visible: Vec<Selected> = selected
+            .iter()
+            .filter(|s| {
+                let (centre, r) = bounding_sphere(s.patch, radius, self.heights);
+                !beyond_horizon(s.patch, camera.position, radius, self.heights)
+                    && frustum.touches_sphere(centre, r)
+            })
+            .copied()
+            .collect();
+        cpu.insert("cull".to_string(), ms_since(t));
+        stats.selected_patches = selected.len();
+        stats.visible_patches = visible.len();
+
+        // Patches without data: roots first (they stand in for everything), then coarse before fine, within the
+        // per-frame budget; the rest draw an ancestor until their turn.
+        let mut missing: Vec<PatchId> = (0..6)
+            .map(PatchId::root)
+            .filter(|p| !self.cache.contains(p))
+            .collect();
+        let roots = missing.len();
+        let mut wanted: Vec<PatchId> = visible
+            .iter()
+            .map(|s| s.patch)
+            .filter(|p| p.level > 0 && !self.cache.contains(p))
+            .collect();
+        wanted.sort_by_key(|p| (p.level, p.face, p.y, p.x));
+        wanted.dedup();
+        let budget = self.config.rendering.new_patches_per_frame as usize;
+        stats.pending_patches = wanted.len().saturating_sub(budget);
+        missing.extend(wanted.into_iter().take(budget));
+        stats.new_patches = missing.len() - roots;
+
+        // Sections 6.3-6.4: base heights and river samples of the new patches, in parallel.
+        let t = Instant::now();
+        let planet = self.planet;
+        let network = self.network;
+        let prepared: Vec<(PatchId, Vec<f32>, Vec<RiverSample>)> = missing
+            .par_iter()
+            .map(|&p| {
+                let base =
+                    planet
+                        .heights
+                        .patch_with_border(p.face as usize, p.level as u32, p.x, p.y, n);
+                let samples = patch_samples(network, &PatchFrame::new(p, radius, n));
+                (p, base, samples)
+            })
+            .collect();
+        cpu.insert("influence+samples".to_string(), ms_since(t));
+        stats.samples = prepared.iter().map(|p| p.2.len()).sum();
+
+        let t = Instant::now();
+        let mut rec = Recorder::begin(ctx, "frame")?;
+        self.profiler.reset(ctx);
+        let (bytes, river_patches) = self.upload_new_patches(&mut rec, &prepared)?;
+        stats.temporary_sample_bytes = bytes;
+        stats.river_patches = river_patches;
+
+        // Instances: every visible patch, with its own data or the part of its nearest resident ancestor.
+        let instances: Vec<PatchInstance> = visible
+            .iter()
+            .filter_map(|s| {
+                let (source, own) = if self.cache.contains(&s.patch) {
+                    (s.patch, true)
+                } else {
+                    (self.cache.resident_ancestor(s.patch)?, false)
+                };
+                if !own {
+                    stats.fallback_patches += 1;
+                }
+                let data = self.cache.touch(&source)?;
+                Some(instance(s, source, data, camera.position, radius, n))
+            })
+            .collect();
+        let instance_buffer = {
+            let mut buffer = ctx.create_buffer(&BufferDesc {
+                name: "patch instances",
+                size: (instances.len().max(1) * std::mem::size_of::<PatchInstance>()) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })?;
+            buffer.write(0, &instances)?;
+            buffer
+        };
+        let instance_set = rec.buffer_set(&self.instance_layout, &[&instance_buffer])?;
+        rec.free_after_completion(instance_buffer);
+
+        // Section 8: terrain, then water.
+        let sun = self.sun.unwrap_or_else(|| {
+            (camera.position.normalize() * 0.8
+                + camera.up.cross(camera.forward).normalize() * 0.5
+                + camera.up * 0.3)
+                .normalize()
+        });
+        let push = FramePush {
+            view_projection: to_f32(camera.projection() * camera.rotation()),
+            sun: [
+                sun.x as f32,
+                sun.y as f32,
+                sun.z as f32,
+                self.planet.sea_level,
+            ],
+            planet: [
+                radius as f32,
+                n as f32,
+                self.water_mode as u32 as f32,
+                match self.view_mode {
+                    ViewMode::Shaded => 0.0,
+                    ViewMode::Lod => 1.0,
+                    ViewMode::PaintedRed => 2.0,
+                },
+            ],
+            extra: [2.0, 0.0, 0.0, 0.0],
+        };
+        rec.raw_image_transition(
+            target.color_image,
+            vk::ImageAspectFlags::COLOR,
+            color_layouts.0,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::NONE,
+            ),
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+            ),
+        );
+        rec.raw_image_transition(
+            target.depth_image,
+            vk::ImageAspectFlags::DEPTH,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            (
+                vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
+            ),
+        );
+        rec.begin_rendering(target, true);
+        let sets = [self.bindless.set, instance_set];
+        let count = instances.len() as u32;
+        let scope = self.profiler.begin(&mut rec, "terrain")?;
+        let terrain = if self.wireframe_on {
+            &self.wireframe
+        } else {
+            &self.terrain
+        };
+        if count > 0 {
+            rec.draw_indexed(
+                terrain,
+                &sets,
+                bytemuck::bytes_of(&push),
+                &self.indices,
+                self.index_count,
+                count,
+            );
+        }
+        self.profiler.end(&mut rec, scope);
+        let scope = self.profiler.begin(&mut rec, "water")?;
+        if count > 0 && !self.wireframe_on {
+            rec.draw_indexed(
+                &self.water,
+                &sets,
+                bytemuck::bytes_of(&push),
+                &self.indices,
+                self.index_count,
+                count,
+            );
+        }
+        self.profiler.end(&mut rec, scope);
+        rec.end_rendering();
+        if color_layouts.1 != vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL {
+            rec.raw_image_transition(
+                target.color_image,
+                vk::ImageAspectFlags::COLOR,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                color_layouts.1,
+                (
+                    vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                    vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
+                    vk::AccessFlags2::NONE,
+                ),
+            );
+        }
+        cpu.insert("record".to_string(), ms_since(t));
+
+        let t = Instant::now();
+        let id = rec.submit_with(waits, signals)?;
+        ctx.wait(id)?;
+        cpu.insert("gpu wait".to_string(), ms_since(t));
+        for scope in self.profiler.read(ctx)? {
+            *stats.gpu_ms.entry(scope.name).or_default() += scope.ms;
+        }
+
+        stats.evicted_patches = self.cache.evict(ctx, &mut self.bindless);
+        stats.resident_patches = self.cache.len();
+        stats.patch_texture_bytes = self.cache.bytes();
+        stats.precomputed_height_bytes = self.planet.heights.bytes();
+        stats.memory_bytes = stats.patch_texture_bytes
+            + stats.temporary_sample_bytes
+            + stats.precomputed_height_bytes;
+        stats.cpu_ms = cpu;
+        stats.frame_ms = ms_since(start);
+        Ok(stats)
+    }
+
+    /// Creates the textures of new patches, uploads base heights, and computes all river textures in one kernel
+    /// dispatch. Returns the temporary sample bytes and how many patches have rivers.
+    fn upload_new_patches(
+        &mut self,
+        rec: &mut Recorder,
+        prepared: &[(PatchId, Vec<f32>, Vec<RiverSample>)],
+    ) -> Result<(u64, usize), GpuError> {
+        if prepared.is_empty() {
+            return Ok((0, 0));
+        }
+        let ctx = self.ctx;
+        let n = self.config.rendering.vertices;
+        let mut bases: Vec<Image> = Vec::with_capacity(prepared.len());
+        for (p, _, _) in prepared {
+            bases.push(ctx.create_image(&ImageDesc {
+                name: &format!("base heights {p:?}"),
+                extent: vk::Extent2D {
+                    width: n + 2,
+                    height: n + 2,
+                },
+                layers: 1,
+                format: BASE_FORMAT,
+                usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+                aspect: vk::ImageAspectFlags::COLOR,
+                array: true,
+            })?);
+        }
+        let base_refs: Vec<&Image> = bases.iter().collect();
+        rec.image_transitions(
+            &base_refs,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+        );
+        for ((_, heights, _), image) in prepared.iter().zip(&bases) {
+            rec.upload_image_layer(image, 0, bytemuck::cast_slice(heights))?;
+        }
+        rec.image_transitions(
+            &base_refs,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::AccessFlags2::SHADER_SAMPLED_READ,
+        );
+
+        let mut rivers: Vec<(Image, Slot)> = Vec::new();
+        let mut jobs: Vec<GpuPatchJob> = Vec::new();
+        let mut samples: Vec<RiverSample> = Vec::new();
+        let mut river_of: Vec<Option<usize>> = Vec::with_capacity(prepared.len());
+        for (p, _, patch_samples) in prepared {
+            if patch_samples.is_empty() {
+                river_of.push(None);
+                continue;
+            }
+            let slot = self.slot()?;
+            let image = create_river_texture(ctx, n, &format!("river data {p:?}"))?;
+            self.bindless
+                .write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            jobs.push(GpuPatchJob {
+                spacing: PatchFrame::new(*p, self.planet.radius, n).spacing() as f32,
+                sample_offset: samples.len() as u32,
+                sample_count: patch_samples.len() as u32,
+                slot: slot.0,
+            });
+            samples.extend_from_slice(patch_samples);
+            river_of.push(Some(rivers.len()));
+            rivers.push((image, slot));
+        }
+        let mut bytes = 0;
+        if !rivers.is_empty() {
+            let refs: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
+            rec.image_transitions(
+                &refs,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::GENERAL,
+                vk::PipelineStageFlags2::NONE,
+                vk::AccessFlags2::NONE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            let scope = self.profiler.begin(rec, "kernel")?;
+            bytes = self.kernel.record(
+                rec,
+                &self.bindless,
+                self.variant,
+                &jobs,
+                &samples,
+                &self.params,
+            )?;
+            self.profiler.end(rec, scope);
+            rec.memory_barrier(
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::VERTEX_SHADER
+                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
+                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_SAMPLED_READ,
+            );
+        }
+        let river_count = rivers.len();
+        let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();
+        for (((p, _, s), base), river) in prepared.iter().zip(bases).zip(river_of) {
+            let slot = self.slot()?;
+            self.bindless.write(
+                ctx,
+                slot,
+                &base,
+                false,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            );
+            let river = river.and_then(|k| rivers[k].take());
+            self.cache
+                .insert(*p, PatchData::new(base, slot, river, s.len()));
+        }
+        Ok((bytes, river_count))
+    }
+
+    /// A free bindless slot, evicting the least recently used patches if none is left.
+    fn slot(&mut self) -> Result<Slot, GpuError> {
+        if let Some(s) = self.bindless.allocate() {
+            return Ok(s);
+        }
+        self.cache.evict(self.ctx, &mut self.bindless);
+        self.bindless.allocate().ok_or_else(|| {
+            GpuError::Invalid(format!(
+                "all {} bindless slots are in use; raise max-resident-patches or lower new-patches-per-frame",
+                self.bindless.capacity
+            ))
+        })
+    }
+
+    pub fn resident_patches(&self) -> usize {
+        self.cache.len()
+    }
+
+    /// Frees every GPU object of the renderer (after the device is idle).
+    pub fn destroy(mut self) {
+        let ctx = self.ctx;
+        let _ = ctx.wait_idle();
+        self.cache.clear(ctx, &mut self.bindless);
+        ctx.retire_buffer(self.indices);
+        self.profiler.destroy(ctx);
+        self.kernel.destroy(ctx);
+        self.terrain.destroy(ctx);
+        self.water.destroy(ctx);
+        self.wireframe.destroy(ctx);
+        self.instance_layout.destroy(ctx);
+        let _ = ctx.wait_idle();
+        self.bindless.destroy(ctx);
+    }
+}
+
+/// The instance that draws `selected` from `source`'s textures (itself, or an ancestor standing in).
+fn instance(
+    selected: &Selected,
+    source: PatchId,
+    data: &PatchData,
+    camera: DVec3,
+    radius: f64,
+    n: u32,
+) -> PatchInstance {
+    let p = selected.patch;
+    let centre = p.center();
+    let rel = centre * radius - camera;
+    let (u0, v0) = p.origin();
+    let depth = (p.level - source.level) as u32;
+    let scale = 1.0 / (1u32 << depth) as f32;
+    let offset_x = (p.x - (source.x << depth)) as f32 * scale * (n - 1) as f32;
+    let offset_y = (p.y - (source.y << depth)) as f32 * scale * (n - 1) as f32;
+    let spacing = PatchFrame::new(p, radius, n).spacing();
+    PatchInstance {
+        centre_rel: [rel.x as f32, rel.y as f32, rel.z as f32, p.level as f32],
+        centre_dir: [
+            centre.x as f32,
+            centre.y as f32,
+            centre.z as f32,
+            spacing as f32,
+        ],
+        uv_rect: [u0 as f32, v0 as f32, p.size() as f32, p.face as f32],
+        tex_rect: [offset_x, offset_y, scale, 0.0],
+        slots: [
+            data.base_slot.0 as i32,
+            data.river.as_ref().map_or(-1, |(_, s)| s.0 as i32),
+            selected.quadrants as i32,
+            0,
+        ],
+    }
+}

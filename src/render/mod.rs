@@ -1,0 +1,9 @@
+//! Rendering (Chapter 8): the patch mesh, the terrain and water pipelines, the frame loop, offscreen targets and
+//! the viewer.
+
+pub mod frame;
+pub mod mesh;
+pub mod presets;
+pub mod target;
+
+pub use frame::{FrameStats, Renderer, ViewMode, WaterMode};

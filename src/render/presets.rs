@@ -1,0 +1,57 @@
+//! Camera placements derived from the planet's own features, so that documentation images and tests find a
+//! mountain range or a river on any seed.
+
+use glam::DVec3;
+
+use crate::world::World;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preset {
+    /// The whole planet from orbit, centred on the first river.
+    Orbit,
+    /// Above the first river's source mountain, looking across the range.
+    Mountains,
+    /// Close above the first river's middle, looking along it.
+    River,
+}
+
+/// (eye, look-at) for `preset`, or `None` when the planet has no river.
+pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
+    let system = world.network.systems.first()?;
+    let r = world.planet.radius;
+    let up = |d: DVec3| d.normalize();
+    let height = |d: DVec3| world.planet.height_at(d) as f64;
+    Some(match preset {
+        Preset::Orbit => {
+            let d = up(system.source + DVec3::Y * 0.25);
+            (d * r * 3.2, DVec3::ZERO)
+        }
+        Preset::Mountains => {
+            let top = system.source;
+            let away = (system.source - system.mouth).normalize();
+            let eye_dir = up(top + away * 0.06);
+            (
+                eye_dir * (r + height(eye_dir).max(0.0) + 70.0),
+                top * (r + height(top)),
+            )
+        }
+        Preset::River => {
+            let middle = system.segments[system.segments.len() / 2].curve.point(0.5);
+            let target = system.frame.to_sphere(middle);
+            let along = system.frame.to_sphere(
+                middle
+                    + system.segments[system.segments.len() / 2]
+                        .curve
+                        .derivative(0.5)
+                        .normalize()
+                        * 40.0,
+            );
+            let back = (target - along).normalize();
+            let eye_dir = up(target + back * 0.03);
+            (
+                eye_dir * (r + height(eye_dir).max(0.4) + 25.0),
+                target * (r + height(target)),
+            )
+        }
+    })
+}

@@ -1,0 +1,115 @@
+//! An offscreen colour + depth target, and reading it back into an image.
+
+use crate::gpu::{
+    pipeline::RenderTarget, vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation,
+    Recorder,
+};
+
+pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// Colour and depth images of one size.
+pub struct Offscreen {
+    pub color: Image,
+    pub depth: Image,
+}
+
+impl Offscreen {
+    pub fn new(ctx: &Context, width: u32, height: u32) -> Result<Self, GpuError> {
+        let extent = vk::Extent2D { width, height };
+        let color = ctx.create_image(&ImageDesc {
+            name: "offscreen colour",
+            extent,
+            layers: 1,
+            format: COLOR_FORMAT,
+            usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            aspect: vk::ImageAspectFlags::COLOR,
+            array: false,
+        })?;
+        let depth = create_depth(ctx, extent)?;
+        Ok(Self { color, depth })
+    }
+
+    pub fn target(&self, clear_color: [f32; 4]) -> RenderTarget {
+        RenderTarget {
+            color_image: self.color.raw,
+            color_view: self.color.view,
+            depth_image: self.depth.raw,
+            depth_view: self.depth.view,
+            extent: self.color.extent,
+            clear_color,
+        }
+    }
+
+    /// Reads the colour image (after a frame left it in COLOR_ATTACHMENT_OPTIMAL) as RGBA8.
+    pub fn read(&self, ctx: &Context) -> Result<image::RgbaImage, GpuError> {
+        let (w, h) = (self.color.extent.width, self.color.extent.height);
+        let buffer = ctx.create_buffer(&BufferDesc {
+            name: "offscreen readback",
+            size: (w * h * 4) as u64,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        let result = ctx.run_and_wait("read offscreen colour", |rec: &mut Recorder| {
+            rec.image_transitions(
+                &[&self.color],
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_READ,
+            );
+            rec.copy_image_to_buffer(
+                &self.color,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                &buffer,
+                0,
+            );
+            rec.buffer_barrier(
+                &buffer,
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::HOST,
+                vk::AccessFlags2::HOST_READ,
+            );
+            rec.image_transitions(
+                &[&self.color],
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_READ,
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+            );
+            Ok(())
+        });
+        let image = result.and_then(|()| {
+            let bytes = buffer
+                .mapped()
+                .ok_or_else(|| GpuError::Invalid("readback not host-visible".into()))?;
+            image::RgbaImage::from_raw(w, h, bytes.to_vec())
+                .ok_or_else(|| GpuError::Invalid("readback size mismatch".into()))
+        });
+        ctx.retire_buffer(buffer);
+        image
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        ctx.retire_image(self.color);
+        ctx.retire_image(self.depth);
+    }
+}
+
+/// A depth image for a target of `extent`.
+pub fn create_depth(ctx: &Context, extent: vk::Extent2D) -> Result<Image, GpuError> {
+    ctx.create_image(&ImageDesc {
+        name: "depth",
+        extent,
+        layers: 1,
+        format: DEPTH_FORMAT,
+        usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        aspect: vk::ImageAspectFlags::DEPTH,
+        array: false,
+    })
+}
