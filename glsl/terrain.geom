@@ -15,6 +15,7 @@ layout(location = 2) in vec3 vDirection[];
 layout(location = 3) in vec4 vRiver[];
 layout(location = 4) in vec2 vGrid[];
 layout(location = 5) flat in int vInstance[];
+layout(location = 6) flat in int vSkirt[];
 
 layout(location = 0) out vec3 fPosition;
 layout(location = 1) out vec3 fNormal;
@@ -28,7 +29,18 @@ void main() {
     float middle = 0.5 * (frame.planet.y - 1.0);
     vec2 middleOfTriangle = (vGrid[0] + vGrid[1] + vGrid[2]) / 3.0;
     int quadrant = int(middleOfTriangle.x >= middle) | (int(middleOfTriangle.y >= middle) << 1);
-    if ((p.slots.z & (1 << quadrant)) == 0) return;
+    int skirt = max(max(vSkirt[0], vSkirt[1]), vSkirt[2]);
+    if (skirt >= 4) {
+        // A midline skirt: drawn beside a drawn quadrant that borders an undrawn one (where a finer patch is).
+        // The midline lies on the boundary, so the two quadrants beside it differ in bit 0 (vertical midline) or
+        // bit 1 (horizontal midline).
+        int bit = skirt == 4 ? 1 : 2;
+        bool a = (p.slots.z & (1 << (quadrant | bit))) != 0;
+        bool b = (p.slots.z & (1 << (quadrant & ~bit))) != 0;
+        if (a == b || WATER_PASS == 1) return;
+    } else if ((p.slots.z & (1 << quadrant)) == 0) {
+        return;
+    }
 
     float spacing = p.centreDir.w;
     float seaLevel = frame.sun.w;

@@ -9,6 +9,7 @@ layout(location = 2) out vec3 vDirection;   // unit direction from the planet ce
 layout(location = 3) out vec4 vRiver;       // final height, water height, signed distance, river half width
 layout(location = 4) out vec2 vGrid;        // (i, j) within the patch
 layout(location = 5) flat out int vInstance;
+layout(location = 6) flat out int vSkirt;       // -1 surface, 0-3 edge skirts, 4-5 midline skirts
 
 const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
 const vec3 FACE_U[6] = vec3[](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0), vec3(1, 0, 0), vec3(1, 0, 0), vec3(-1, 0, 0));
@@ -47,12 +48,15 @@ void main() {
     int id = gl_VertexIndex;
     bool skirt = id >= n * n;
     ivec2 ij;
+    int edge = -1;
     if (!skirt) {
         ij = ivec2(id % n, id / n);
     } else {
-        int e = (id - n * n) / n;
+        edge = (id - n * n) / n;
         int k = (id - n * n) % n;
-        ij = e == 0 ? ivec2(k, 0) : e == 1 ? ivec2(k, n - 1) : e == 2 ? ivec2(0, k) : ivec2(n - 1, k);
+        int m = (n - 1) / 2;
+        ivec2 along[6] = ivec2[](ivec2(k, 0), ivec2(k, n - 1), ivec2(0, k), ivec2(n - 1, k), ivec2(m, k), ivec2(k, m));
+        ij = along[edge];
     }
     vec2 grid = vec2(ij);
     float base;
@@ -81,5 +85,6 @@ void main() {
     vRiver = vec4(height, surface.y, surface.z, surface.w);
     vGrid = grid;
     vInstance = gl_InstanceIndex;
+    vSkirt = edge;
     gl_Position = frame.viewProjection * vec4(position, 1.0);
 }
