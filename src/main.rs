@@ -54,6 +54,8 @@ enum Command {
     },
     /// Render one image headless (no display, no window system) and print per-pass GPU times.
     Render(RenderArgs),
+    /// Open the interactive viewer (needs a display; see the README for keys).
+    View(ViewArgs),
     /// Measure the river kernel variants side by side in one run.
     Bench {
         #[command(subcommand)]
@@ -95,6 +97,28 @@ struct RenderArgs {
     max_frames: u32,
     #[arg(long)]
     out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct ViewArgs {
+    #[arg(long, default_value = "config/planet.xml")]
+    config: PathBuf,
+    #[arg(long)]
+    seed: Option<u32>,
+    #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+    size: [u32; 2],
+    /// Start position (default: the orbit preset).
+    #[arg(long, value_parser = parse_vec3)]
+    eye: Option<glam::DVec3>,
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0")]
+    look_at: glam::DVec3,
+    #[arg(long, value_enum, default_value = "auto")]
+    water: WaterMode,
+    /// Run this many frames, then exit (with --screenshot, write it first).
+    #[arg(long)]
+    frames: Option<u64>,
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -147,6 +171,13 @@ fn main() -> ExitCode {
             }
         },
         Command::Render(args) => match render(&options, &args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::View(args) => match view(&options, &args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e:#}");
@@ -507,5 +538,35 @@ fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
             errors[0]
         );
     }
+    Ok(())
+}
+
+fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
+    let config = load_config(&args.config)?;
+    let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
+    let world = riverplanet::world::World::build(&config, seed)?;
+    let (eye, look_at) = match args.eye {
+        Some(eye) => (eye, args.look_at),
+        None => riverplanet::render::presets::camera(
+            riverplanet::render::presets::Preset::Orbit,
+            &world,
+        )
+        .unwrap_or((
+            glam::DVec3::new(0.0, 0.0, config.planet.radius as f64 * 3.0),
+            glam::DVec3::ZERO,
+        )),
+    };
+    riverplanet::render::viewer::run(
+        &world,
+        options,
+        riverplanet::render::viewer::ViewerOptions {
+            size: args.size,
+            eye,
+            look_at,
+            frames: args.frames,
+            screenshot: args.screenshot.clone(),
+            water: args.water,
+        },
+    )?;
     Ok(())
 }

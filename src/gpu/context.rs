@@ -67,7 +67,7 @@ pub struct ValidationLog {
 
 /// The device and everything needed to use it. Shared by reference; internally synchronised.
 pub struct Context {
-    _entry: ash::Entry,
+    pub(crate) entry: ash::Entry,
     pub instance: ash::Instance,
     debug_instance: Option<ext::debug_utils::Instance>,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -410,7 +410,7 @@ impl Context {
             if validation_enabled { "on" } else { "off" }
         );
         Ok(Self {
-            _entry: entry,
+            entry,
             instance,
             debug_instance,
             messenger,

@@ -3,7 +3,8 @@
 //! One file per concern, as in wgpu-hal: [`context`] (instance, device choice, device, queue, allocator),
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
 //! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`bindless`] (the global
-//! descriptor-indexed set), [`pipeline`] (shader modules and pipelines), [`profiler`] (timestamp scopes).
+//! descriptor-indexed set), [`pipeline`] (shader modules and pipelines), [`profiler`] (timestamp scopes),
+//! [`swapchain`] (window presentation).
 
 pub mod bindless;
 pub mod context;
@@ -12,6 +13,7 @@ pub mod memory;
 pub mod pipeline;
 pub mod profiler;
 pub mod submit;
+pub mod swapchain;
 
 pub use ash::vk;
 pub use context::{AdapterInfo, Context, ContextOptions};

@@ -5,5 +5,6 @@ pub mod frame;
 pub mod mesh;
 pub mod presets;
 pub mod target;
+pub mod viewer;
 
 pub use frame::{FrameStats, Renderer, ViewMode, WaterMode};

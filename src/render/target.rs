@@ -15,13 +15,24 @@ pub struct Offscreen {
 }
 
 impl Offscreen {
+    /// A target in `COLOR_FORMAT`.
     pub fn new(ctx: &Context, width: u32, height: u32) -> Result<Self, GpuError> {
+        Self::with_format(ctx, width, height, COLOR_FORMAT)
+    }
+
+    /// A target in `format` (RGBA8 or BGRA8 UNORM), to match pipelines made for a swapchain.
+    pub fn with_format(
+        ctx: &Context,
+        width: u32,
+        height: u32,
+        format: vk::Format,
+    ) -> Result<Self, GpuError> {
         let extent = vk::Extent2D { width, height };
         let color = ctx.create_image(&ImageDesc {
             name: "offscreen colour",
             extent,
             layers: 1,
-            format: COLOR_FORMAT,
+            format,
             usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
             aspect: vk::ImageAspectFlags::COLOR,
             array: false,
@@ -88,7 +99,11 @@ impl Offscreen {
             let bytes = buffer
                 .mapped()
                 .ok_or_else(|| GpuError::Invalid("readback not host-visible".into()))?;
-            image::RgbaImage::from_raw(w, h, bytes.to_vec())
+            let mut pixels = bytes.to_vec();
+            if self.color.format == vk::Format::B8G8R8A8_UNORM {
+                pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+            }
+            image::RgbaImage::from_raw(w, h, pixels)
                 .ok_or_else(|| GpuError::Invalid("readback size mismatch".into()))
         });
         ctx.retire_buffer(buffer);

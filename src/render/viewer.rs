@@ -1,0 +1,541 @@
+//! The native viewer (winit): a fly camera whose speed scales with altitude, keys for the water mode, wireframe,
+//! level-of-detail colours, freezing the level of detail, the kernel variant and screenshots; frame and per-pass
+//! GPU times in the title bar. Survives resize and minimise.
+//!
+//! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look, Shift faster; M water mode,
+//! F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, K simple/tiled
+//! kernel, P screenshot, Escape quit.
+
+use std::{collections::HashSet, path::PathBuf, time::Instant};
+
+use glam::DVec3;
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::{
+    application::ApplicationHandler,
+    dpi::PhysicalSize,
+    event::{ElementState, MouseButton, WindowEvent},
+    event_loop::{ActiveEventLoop, ControlFlow, EventLoop},
+    keyboard::{KeyCode, PhysicalKey},
+    window::{Window, WindowId},
+};
+
+use super::{
+    frame::{FrameStats, Renderer, ViewMode},
+    target::{create_depth, Offscreen, DEPTH_FORMAT},
+};
+use crate::{
+    gpu::{
+        pipeline::RenderTarget,
+        swapchain::{self, Surface, Swapchain, SWAPCHAIN_FORMAT},
+        vk, Context, ContextOptions, GpuError, Image,
+    },
+    kernel::gpu::KernelVariant,
+    runtime::camera::Camera,
+    world::World,
+};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    #[error("cannot open a window: {0} (no display? `riverplanet render` works without one)")]
+    Window(String),
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error("cannot write screenshot {path}: {message}")]
+    Screenshot { path: String, message: String },
+    #[error("the validation layer reported {count} error(s), the first: {first}")]
+    Validation { count: usize, first: String },
+}
+
+/// Options of a viewer run.
+#[derive(Clone, Debug)]
+pub struct ViewerOptions {
+    pub size: [u32; 2],
+    pub eye: DVec3,
+    pub look_at: DVec3,
+    /// Stop after this many frames (for tests under Xvfb).
+    pub frames: Option<u64>,
+    /// Written after the last frame (with `frames`) or on P.
+    pub screenshot: Option<PathBuf>,
+    pub water: super::WaterMode,
+}
+
+/// Opens the viewer and runs until the window closes (or `frames` are done).
+pub fn run(
+    world: &World,
+    context_options: &ContextOptions,
+    options: ViewerOptions,
+) -> Result<(), ViewerError> {
+    let event_loop = EventLoop::new().map_err(|e| ViewerError::Window(e.to_string()))?;
+    let display = event_loop
+        .display_handle()
+        .map_err(|e| ViewerError::Window(e.to_string()))?
+        .as_raw();
+    let mut ctx_options = context_options.clone();
+    ctx_options.instance_extensions = swapchain::surface_extensions(display)?;
+    ctx_options.swapchain = true;
+    let ctx = Context::new(&ctx_options)?;
+    let renderer = Renderer::new(
+        &ctx,
+        &world.planet,
+        &world.network,
+        &world.config,
+        SWAPCHAIN_FORMAT,
+        DEPTH_FORMAT,
+    )?;
+    let camera = FlyCamera::new(options.eye, options.look_at);
+    let mut app = App {
+        ctx: &ctx,
+        world,
+        renderer: Some(renderer),
+        options,
+        window: None,
+        surface: None,
+        swapchain: None,
+        depth: None,
+        camera,
+        keys: HashSet::new(),
+        dragging: false,
+        cursor: None,
+        last: Instant::now(),
+        frames: 0,
+        smoothed_ms: 0.0,
+        last_stats: FrameStats::default(),
+        error: None,
+    };
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let run = event_loop
+        .run_app(&mut app)
+        .map_err(|e| ViewerError::Window(e.to_string()));
+    app.shutdown();
+    run?;
+    if let Some(e) = app.error {
+        return Err(e);
+    }
+    let errors = ctx.validation_errors();
+    match errors.first() {
+        Some(first) => Err(ViewerError::Validation {
+            count: errors.len(),
+            first: first.clone(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Position and orientation of the viewer's camera; "up" follows the planet's normal below the camera.
+struct FlyCamera {
+    position: DVec3,
+    forward: DVec3,
+}
+
+impl FlyCamera {
+    fn new(eye: DVec3, target: DVec3) -> Self {
+        Self {
+            position: eye,
+            forward: (target - eye).normalize(),
+        }
+    }
+
+    fn up(&self) -> DVec3 {
+        self.position.normalize()
+    }
+
+    fn right(&self) -> DVec3 {
+        self.forward
+            .cross(self.up())
+            .try_normalize()
+            .unwrap_or_else(|| self.forward.any_orthonormal_vector())
+    }
+
+    fn turn(&mut self, yaw: f64, pitch: f64) {
+        let up = self.up();
+        let right = self.right();
+        let f = glam::DQuat::from_axis_angle(up, -yaw) * self.forward;
+        let f = glam::DQuat::from_axis_angle(right, pitch) * f;
+        // Keep away from looking straight up or down, where "right" is undefined.
+        if f.dot(up).abs() < 0.995 {
+            self.forward = f.normalize();
+        }
+    }
+}
+
+struct App<'a> {
+    ctx: &'a Context,
+    world: &'a World,
+    renderer: Option<Renderer<'a>>,
+    options: ViewerOptions,
+    window: Option<Window>,
+    surface: Option<Surface>,
+    swapchain: Option<Swapchain>,
+    depth: Option<Image>,
+    camera: FlyCamera,
+    keys: HashSet<KeyCode>,
+    dragging: bool,
+    cursor: Option<(f64, f64)>,
+    last: Instant,
+    frames: u64,
+    smoothed_ms: f64,
+    last_stats: FrameStats,
+    error: Option<ViewerError>,
+}
+
+impl App<'_> {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: ViewerError) {
+        log::error!("{error}");
+        self.error = Some(error);
+        event_loop.exit();
+    }
+
+    fn radius(&self) -> f64 {
+        self.world.planet.radius
+    }
+
+    fn altitude(&self) -> f64 {
+        let d = self.camera.position;
+        d.length()
+            - self.radius()
+            - self
+                .world
+                .planet
+                .height_at(d)
+                .max(self.world.planet.sea_level) as f64
+    }
+
+    fn recreate_swapchain(&mut self) -> Result<(), ViewerError> {
+        let (Some(window), Some(surface)) = (&self.window, &self.surface) else {
+            return Ok(());
+        };
+        let PhysicalSize { width, height } = window.inner_size();
+        if width == 0 || height == 0 {
+            return Ok(());
+        }
+        self.ctx.wait_idle()?;
+        if let Some(old) = self.swapchain.take() {
+            old.destroy(self.ctx);
+        }
+        if let Some(depth) = self.depth.take() {
+            self.ctx.retire_image(depth);
+        }
+        let swapchain = Swapchain::new(self.ctx, surface, width, height)?;
+        self.depth = Some(create_depth(self.ctx, swapchain.extent)?);
+        self.swapchain = Some(swapchain);
+        Ok(())
+    }
+
+    fn camera(&self, width: u32, height: u32) -> Camera {
+        let altitude = self.altitude().max(0.01);
+        let p = self.camera.position;
+        Camera::look_at(
+            p,
+            p + self.camera.forward,
+            60.0,
+            width as f64 / height.max(1) as f64,
+            (altitude * 0.05).clamp(0.01, 10.0),
+        )
+    }
+
+    fn update_camera(&mut self, dt: f64) {
+        let fast =
+            self.keys.contains(&KeyCode::ShiftLeft) || self.keys.contains(&KeyCode::ShiftRight);
+        let speed = self.altitude().max(0.5) * if fast { 3.0 } else { 0.8 };
+        let (f, r, u) = (self.camera.forward, self.camera.right(), self.camera.up());
+        let mut motion = DVec3::ZERO;
+        for (key, dir) in [
+            (KeyCode::KeyW, f),
+            (KeyCode::KeyS, -f),
+            (KeyCode::KeyD, r),
+            (KeyCode::KeyA, -r),
+            (KeyCode::KeyE, u),
+            (KeyCode::KeyQ, -u),
+        ] {
+            if self.keys.contains(&key) {
+                motion += dir;
+            }
+        }
+        self.camera.position += motion * speed * dt;
+        // Never below the ground.
+        let ground = self.radius()
+            + self
+                .world
+                .planet
+                .height_at(self.camera.position)
+                .max(self.world.planet.sea_level) as f64;
+        if self.camera.position.length() < ground + 0.3 {
+            self.camera.position = self.camera.position.normalize() * (ground + 0.3);
+        }
+        let turn = 1.2 * dt;
+        for (key, yaw, pitch) in [
+            (KeyCode::ArrowLeft, -turn, 0.0),
+            (KeyCode::ArrowRight, turn, 0.0),
+            (KeyCode::ArrowUp, 0.0, turn),
+            (KeyCode::ArrowDown, 0.0, -turn),
+        ] {
+            if self.keys.contains(&key) {
+                self.camera.turn(yaw, pitch);
+            }
+        }
+    }
+
+    fn draw(&mut self) -> Result<(), ViewerError> {
+        let now = Instant::now();
+        let dt = (now - self.last).as_secs_f64().min(0.25);
+        self.last = now;
+        self.update_camera(dt);
+        if self.swapchain.is_none() {
+            self.recreate_swapchain()?;
+        }
+        let Some(extent) = self.swapchain.as_ref().map(|s| s.extent) else {
+            return Ok(());
+        }; // minimised
+        let camera = self.camera(extent.width, extent.height);
+        let (Some(swapchain), Some(depth), Some(renderer)) =
+            (&self.swapchain, &self.depth, &mut self.renderer)
+        else {
+            return Ok(());
+        };
+        let Some((index, acquired, rendered)) = swapchain.acquire()? else {
+            return self.recreate_swapchain();
+        };
+        let target = RenderTarget {
+            color_image: swapchain.images[index as usize],
+            color_view: swapchain.views[index as usize],
+            depth_image: depth.raw,
+            depth_view: depth.view,
+            extent,
+            clear_color: [0.02, 0.03, 0.06, 1.0],
+        };
+        let stats = renderer.render(
+            &camera,
+            &target,
+            (vk::ImageLayout::UNDEFINED, vk::ImageLayout::PRESENT_SRC_KHR),
+            &[(acquired, vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)],
+            &[rendered],
+        )?;
+        let presented = swapchain.present(self.ctx, index)?;
+        self.frames += 1;
+        self.smoothed_ms = if self.frames == 1 {
+            stats.frame_ms
+        } else {
+            0.9 * self.smoothed_ms + 0.1 * stats.frame_ms
+        };
+        self.update_title(&stats);
+        self.last_stats = stats;
+        if !presented {
+            self.recreate_swapchain()?;
+        }
+        Ok(())
+    }
+
+    fn update_title(&self, stats: &FrameStats) {
+        let Some(window) = &self.window else { return };
+        let renderer = self.renderer.as_ref();
+        let gpu = |name: &str| stats.gpu_ms.get(name).copied().unwrap_or(0.0);
+        window.set_title(&format!(
+            "riverplanet | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} ms | {} patches ({} new) | \
+             altitude {:.1} | water {:?}{}{}",
+            self.smoothed_ms,
+            1000.0 / self.smoothed_ms.max(1e-3),
+            gpu("kernel"),
+            gpu("terrain"),
+            gpu("water"),
+            stats.visible_patches,
+            stats.new_patches,
+            self.altitude(),
+            renderer.map(|r| r.water_mode).unwrap_or(super::WaterMode::Auto),
+            if renderer.is_some_and(|r| r.freeze_lod) { " | lod frozen" } else { "" },
+            if renderer.is_some_and(|r| r.variant == KernelVariant::Simple) { " | simple kernel" } else { "" },
+        ));
+    }
+
+    /// Renders the current view offscreen at the window's size and writes it as PNG.
+    fn screenshot(&mut self, path: &std::path::Path) -> Result<(), ViewerError> {
+        let [w, h] = self
+            .swapchain
+            .as_ref()
+            .map_or(self.options.size, |s| [s.extent.width, s.extent.height]);
+        let camera = self.camera(w, h);
+        let Some(renderer) = &mut self.renderer else {
+            return Ok(());
+        };
+        let target = Offscreen::with_format(self.ctx, w, h, SWAPCHAIN_FORMAT)?;
+        let result = (|| {
+            for _ in 0..50 {
+                let stats = renderer.render(
+                    &camera,
+                    &target.target([0.02, 0.03, 0.06, 1.0]),
+                    (
+                        vk::ImageLayout::UNDEFINED,
+                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                    ),
+                    &[],
+                    &[],
+                )?;
+                if stats.pending_patches == 0 && stats.fallback_patches == 0 {
+                    break;
+                }
+            }
+            target.read(self.ctx)
+        })();
+        target.destroy(self.ctx);
+        let image = result?;
+        image.save(path).map_err(|e| ViewerError::Screenshot {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        println!("screenshot: {}", path.display());
+        Ok(())
+    }
+
+    fn key(&mut self, event_loop: &ActiveEventLoop, code: KeyCode) {
+        let Some(renderer) = &mut self.renderer else {
+            return;
+        };
+        match code {
+            KeyCode::Escape => event_loop.exit(),
+            KeyCode::KeyM => renderer.water_mode = renderer.water_mode.next(),
+            KeyCode::KeyF => renderer.wireframe_on = !renderer.wireframe_on,
+            KeyCode::KeyL => {
+                renderer.view_mode = if renderer.view_mode == ViewMode::Lod {
+                    ViewMode::Shaded
+                } else {
+                    ViewMode::Lod
+                }
+            }
+            KeyCode::KeyR => {
+                renderer.view_mode = if renderer.view_mode == ViewMode::PaintedRed {
+                    ViewMode::Shaded
+                } else {
+                    ViewMode::PaintedRed
+                }
+            }
+            KeyCode::KeyZ => renderer.freeze_lod = !renderer.freeze_lod,
+            KeyCode::KeyK => {
+                renderer.variant = match renderer.variant {
+                    KernelVariant::Simple => KernelVariant::Tiled,
+                    KernelVariant::Tiled => KernelVariant::Simple,
+                }
+            }
+            KeyCode::KeyP => {
+                let path = PathBuf::from(format!("riverplanet-{}.png", self.frames));
+                if let Err(e) = self.screenshot(&path) {
+                    self.fail(event_loop, e);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn shutdown(&mut self) {
+        let _ = self.ctx.wait_idle();
+        if let Some(renderer) = self.renderer.take() {
+            renderer.destroy();
+        }
+        if let Some(swapchain) = self.swapchain.take() {
+            swapchain.destroy(self.ctx);
+        }
+        if let Some(depth) = self.depth.take() {
+            self.ctx.retire_image(depth);
+        }
+        if let Some(surface) = self.surface.take() {
+            surface.destroy();
+        }
+        let _ = self.ctx.wait_idle();
+    }
+}
+
+impl ApplicationHandler for App<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title("riverplanet")
+            .with_inner_size(PhysicalSize::new(
+                self.options.size[0],
+                self.options.size[1],
+            ));
+        let created = event_loop
+            .create_window(attributes)
+            .map_err(|e| ViewerError::Window(e.to_string()));
+        let window = match created {
+            Ok(w) => w,
+            Err(e) => return self.fail(event_loop, e),
+        };
+        let handles = window
+            .display_handle()
+            .and_then(|d| window.window_handle().map(|w| (d.as_raw(), w.as_raw())))
+            .map_err(|e| ViewerError::Window(e.to_string()));
+        let surface =
+            handles.and_then(|(d, w)| Surface::new(self.ctx, d, w).map_err(ViewerError::from));
+        match surface {
+            Ok(s) => self.surface = Some(s),
+            Err(e) => return self.fail(event_loop, e),
+        }
+        self.window = Some(window);
+        if let Some(renderer) = &mut self.renderer {
+            renderer.water_mode = self.options.water;
+        }
+        if let Err(e) = self.recreate_swapchain() {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(_) => {
+                if let Err(e) = self.recreate_swapchain() {
+                    self.fail(event_loop, e);
+                }
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    match event.state {
+                        ElementState::Pressed => {
+                            if !event.repeat {
+                                self.key(event_loop, code);
+                            }
+                            self.keys.insert(code);
+                        }
+                        ElementState::Released => {
+                            self.keys.remove(&code);
+                        }
+                    }
+                }
+            }
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
+                self.dragging = state == ElementState::Pressed;
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let (true, Some((x, y))) = (self.dragging, self.cursor) {
+                    self.camera
+                        .turn((position.x - x) * 0.004, -(position.y - y) * 0.004);
+                }
+                self.cursor = Some((position.x, position.y));
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.draw() {
+                    return self.fail(event_loop, e);
+                }
+                if self.options.frames.is_some_and(|n| self.frames >= n) {
+                    if let Some(path) = self.options.screenshot.clone() {
+                        if let Err(e) = self.screenshot(&path) {
+                            return self.fail(event_loop, e);
+                        }
+                    }
+                    event_loop.exit();
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(window) = &self.window {
+            window.request_redraw();
+        }
+    }
+}
