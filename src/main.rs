@@ -56,6 +56,17 @@ enum Command {
     Render(RenderArgs),
     /// Open the interactive viewer (needs a display; see the README for keys).
     View(ViewArgs),
+    /// Draw the figures of Chapter 9 (SVG and PNG) from `bench flight` JSON reports.
+    Plot {
+        /// Report of the normal flight.
+        #[arg(long)]
+        flight: PathBuf,
+        /// Report of the stress flight.
+        #[arg(long)]
+        stress: Option<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Measure the river kernel variants side by side in one run.
     Bench {
         #[command(subcommand)]
@@ -123,13 +134,19 @@ struct ViewArgs {
 
 #[derive(Subcommand)]
 enum BenchCommand {
-    /// CPU single-thread, CPU rayon, GPU simple and GPU tiled on identical input (Tables 9.1/9.2).
+    /// CPU single-thread, CPU rayon, GPU simple and GPU tiled on identical input (Tables 9.1/9.2): every river
+    /// patch the scripted flight meets, as one batch.
     Kernel {
         #[arg(long, default_value = "config/planet.xml")]
         config: PathBuf,
-        /// The thesis's stress test: switch factor x10.
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// The thesis's stress test: switch factor x10, camera x25.
         #[arg(long)]
         stress: bool,
+        /// Frames of the flight that produces the workload.
+        #[arg(long, default_value_t = 300)]
+        frames: u32,
         /// Repetitions per variant (the median is reported).
         #[arg(long, default_value_t = 5)]
         repetitions: usize,
@@ -137,7 +154,7 @@ enum BenchCommand {
         #[arg(long, default_value_t = KernelTuning::default().simple_workgroup)]
         simple_workgroup: u32,
         /// Vertex block per workgroup of the tiled kernel, as WxH.
-        #[arg(long, default_value = "8x8", value_parser = parse_block)]
+        #[arg(long, default_value = "8x4", value_parser = parse_block)]
         tiled_block: [u32; 2],
         /// Samples staged per tile by the tiled kernel.
         #[arg(long, default_value_t = KernelTuning::default().tile_size)]
@@ -145,6 +162,30 @@ enum BenchCommand {
         /// Write the report here as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
+    },
+    /// The scripted flight from orbit to the surface, rendered headless, with per-frame statistics (Chapter 9).
+    Flight {
+        #[arg(long, default_value = "config/planet.xml")]
+        config: PathBuf,
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// The thesis's stress test: switch factor x10, camera x25.
+        #[arg(long)]
+        stress: bool,
+        #[arg(long, default_value_t = 300)]
+        frames: u32,
+        #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+        size: [u32; 2],
+        /// Skip rerunning each frame's kernel input through all four variants.
+        #[arg(long)]
+        no_kernel_comparison: bool,
+        /// Skip the flights in the geometry and painted water modes.
+        #[arg(long)]
+        no_water_comparison: bool,
+        #[arg(long)]
+        json: PathBuf,
+        #[arg(long)]
+        csv: Option<PathBuf>,
     },
 }
 
@@ -177,6 +218,31 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Plot {
+            flight,
+            stress,
+            out,
+        } => {
+            let mut result = bench::plot::flight_figures(&flight, &out, "", false);
+            if let (Ok(names), Some(stress)) = (&mut result, stress) {
+                match bench::plot::flight_figures(&stress, &out, "stress_", true) {
+                    Ok(more) => names.extend(more),
+                    Err(e) => result = Err(e),
+                }
+            }
+            match result {
+                Ok(names) => {
+                    for n in names {
+                        println!("{}", out.join(n).with_extension("png").display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::View(args) => match view(&options, &args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
@@ -273,11 +339,26 @@ fn load_config(path: &std::path::Path) -> anyhow::Result<Config> {
     Ok(config)
 }
 
+fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    std::fs::write(path, serde_json::to_string_pretty(value)?)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+}
+
+fn check_validation(ctx: &Context) -> anyhow::Result<()> {
+    let errors = ctx.validation_errors();
+    match errors.first() {
+        Some(first) => anyhow::bail!("validation reported {} error(s): {first}", errors.len()),
+        None => Ok(()),
+    }
+}
+
 fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()> {
     match what {
         BenchCommand::Kernel {
             config,
+            seed,
             stress,
+            frames,
             repetitions,
             simple_workgroup,
             tiled_block,
@@ -285,16 +366,19 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             json,
         } => {
             let config = load_config(&config)?;
+            let world = riverplanet::world::World::build(&config, seed)?;
             let ctx = Context::new(options)?;
             let tuning = KernelTuning {
                 simple_workgroup,
                 tiled_block,
                 tile_size,
             };
-            let report = bench::kernel_bench(&ctx, &config, stress, repetitions, tuning)?;
+            let report =
+                bench::kernel::kernel_bench(&ctx, &world, stress, frames, repetitions, tuning)?;
             let v = &report.variants;
             println!(
-                "device {} | {} patches, {} samples, {} vertex-sample pairs ({} within reach) | rayon threads {}, LP_NUM_THREADS {}",
+                "device {} | {} patches, {} samples, {} vertex-sample pairs ({} within reach) | rayon threads {}, \
+                 LP_NUM_THREADS {}, RAYON_NUM_THREADS {}",
                 report.device,
                 report.patches,
                 report.samples,
@@ -302,6 +386,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 report.relevant_pairs,
                 report.threads.rayon_threads_used,
                 report.threads.lp_num_threads.as_deref().unwrap_or("unset"),
+                report.threads.rayon_num_threads.as_deref().unwrap_or("unset"),
             );
             println!("  cpu single   {:>10.3} ms", v.cpu_single.kernel_ms);
             println!("  cpu rayon    {:>10.3} ms", v.cpu_rayon.kernel_ms);
@@ -313,22 +398,94 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 );
             }
             println!(
-                "  tiled/simple {:.3} | cpu single / gpu tiled end-to-end {:.2}x | max |diff| {:.3e} (height range {:?})",
+                "  tiled/simple {:.3} | cpu single / gpu tiled: {:.2}x kernel, {:.2}x end to end | max |diff| {:.3e} \
+                 = {:.2e} of the height range {:?}",
                 report.ratios.tiled_over_simple,
+                report.ratios.cpu_single_over_gpu_tiled_kernel,
                 report.ratios.cpu_single_over_gpu_tiled_end_to_end,
                 report.max_abs_diff,
+                report.relative_diff,
                 report.height_range
             );
-            let errors = ctx.validation_errors();
-            if !errors.is_empty() {
-                anyhow::bail!(
-                    "validation reported {} error(s): {}",
-                    errors.len(),
-                    errors[0]
-                );
-            }
+            check_validation(&ctx)?;
             if let Some(path) = json {
-                std::fs::write(&path, serde_json::to_string_pretty(&report)?)
+                write_json(&path, &report)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Flight {
+            config,
+            seed,
+            stress,
+            frames,
+            size,
+            no_kernel_comparison,
+            no_water_comparison,
+            json,
+            csv,
+        } => {
+            use std::io::IsTerminal;
+            let config = load_config(&config)?;
+            let world = riverplanet::world::World::build(&config, seed)?;
+            let ctx = Context::new(options)?;
+            let bar = std::io::stderr()
+                .is_terminal()
+                .then(|| indicatif::ProgressBar::new(frames as u64));
+            let options = bench::flight::FlightOptions {
+                frames,
+                stress,
+                size,
+                compare_kernels: !no_kernel_comparison,
+                compare_water_modes: !no_water_comparison,
+            };
+            let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
+                if let Some(bar) = &bar {
+                    bar.set_message(mode.to_string());
+                    bar.set_position(frame as u64 + 1);
+                }
+            })?;
+            if let Some(bar) = bar {
+                bar.finish_and_clear();
+            }
+            let s = &report.summary;
+            println!(
+                "{} frames at {}x{} on {}{}: {:.1} ms/frame average ({:.1} fps), median {:.1}, max {:.1}",
+                s.frames,
+                size[0],
+                size[1],
+                report.device,
+                if stress { " (stress)" } else { "" },
+                s.average_frame_ms,
+                s.average_fps,
+                s.median_frame_ms,
+                s.max_frame_ms
+            );
+            println!(
+                "  patches: {:.1} visible, {:.2} new per frame (max {}); samples {:.0} per frame (max {})",
+                s.average_visible_patches, s.average_new_patches, s.max_new_patches, s.average_samples, s.max_samples
+            );
+            println!(
+                "  memory: max {:.1} MB ({:.1} MB patch textures, {} of {} patches resident; {:.2} MB samples)",
+                s.max_memory_bytes as f64 / 1e6,
+                s.max_patch_texture_bytes as f64 / 1e6,
+                s.max_resident_patches,
+                s.resident_patch_budget,
+                s.max_temporary_sample_bytes as f64 / 1e6
+            );
+            println!("  gpu ms per frame: {:?}", s.average_gpu_ms);
+            println!("  cpu ms per frame: {:?}", s.average_cpu_ms);
+            if s.kernel_frames > 0 {
+                println!(
+                    "  kernel over {} frames, average ms: {:?}",
+                    s.kernel_frames, s.kernel_average_ms
+                );
+                println!("  kernel ratios: {:?}", s.kernel_ratios);
+            }
+            println!("  frame ms by water mode: {:?}", s.water_mode_frame_ms);
+            check_validation(&ctx)?;
+            write_json(&json, &report)?;
+            if let Some(path) = csv {
+                std::fs::write(&path, bench::flight::to_csv(&report))
                     .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
             }
             Ok(())

@@ -45,13 +45,33 @@ pub struct KernelTuning {
 }
 
 impl Default for KernelTuning {
+    /// The best of the sweep in docs/kernel.md (lavapipe): 8x4 vertex blocks, 1024-sample tiles.
     fn default() -> Self {
         Self {
             simple_workgroup: 64,
-            tiled_block: [8, 8],
-            tile_size: 256,
+            tiled_block: [8, 4],
+            tile_size: 1024,
         }
     }
+}
+
+impl KernelTuning {
+    /// The default, with the tile shrunk to what the device's shared memory holds (32 KiB devices get 512).
+    pub fn for_device(ctx: &Context) -> Self {
+        let mut t = Self::default();
+        let shared = ctx.properties.limits.max_compute_shared_memory_size;
+        while t.tile_size > 32
+            && tiled_shared_bytes(t.tile_size, t.tiled_block[0] * t.tiled_block[1]) > shared
+        {
+            t.tile_size /= 2;
+        }
+        t
+    }
+}
+
+/// Shared memory of the tiled kernel: the staged samples (24 bytes each), the per-invocation offsets and a count.
+pub fn tiled_shared_bytes(tile_size: u32, group_size: u32) -> u32 {
+    tile_size * 24 + group_size * 4 + 4
 }
 
 /// One row of the range table (std430, 16 bytes).
@@ -106,6 +126,15 @@ impl RiverKernel {
                     "{what} of {size} invocations must be in [1, {limit}]"
                 )));
             }
+        }
+        let shared = ctx.properties.limits.max_compute_shared_memory_size;
+        let needed = tiled_shared_bytes(tuning.tile_size, block);
+        if needed > shared {
+            return Err(GpuError::Invalid(format!(
+                "tile size {} needs {needed} bytes of shared memory; the device has {shared} (use --tile-size {} or less)",
+                tuning.tile_size,
+                (shared.saturating_sub(tiled_shared_bytes(0, block)) / 24).next_power_of_two() / 2
+            )));
         }
         // The tiled kernel stages at most 32 samples per invocation (a bit mask) and 1024 invocations.
         if tuning.tile_size == 0 || tuning.tile_size > 32 * block || block > 1024 {

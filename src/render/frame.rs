@@ -151,6 +151,10 @@ pub struct Renderer<'w> {
     pub freeze_lod: bool,
     /// Unit direction towards the sun; `None`: over the camera's shoulder.
     pub sun: Option<DVec3>,
+    /// Keep each frame's kernel input in `last_batch` (for benchmarks that rerun it through every variant).
+    pub capture_batches: bool,
+    /// The last frame's new river patches: (vertex spacing, samples).
+    pub last_batch: Vec<(f32, Vec<RiverSample>)>,
 }
 
 impl<'w> Renderer<'w> {
@@ -167,7 +171,7 @@ impl<'w> Renderer<'w> {
         let bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
         // Two slots per patch at most; keep the cache within what the bindless arrays hold.
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
-        let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::default())?;
+        let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
         let instance_layout = BufferSetLayout::new(ctx, 1, "patch instances")?;
         let layouts = [bindless.layout, instance_layout.layout];
         let pipeline = |name: &str, water: bool, wireframe: bool| {
@@ -233,6 +237,8 @@ impl<'w> Renderer<'w> {
             wireframe_on: false,
             freeze_lod: false,
             sun: None,
+            capture_batches: false,
+            last_batch: Vec::new(),
         })
     }
 
@@ -499,11 +505,24 @@ impl<'w> Renderer<'w> {
         rec: &mut Recorder,
         prepared: &[(PatchId, Vec<f32>, Vec<RiverSample>)],
     ) -> Result<(u64, usize), GpuError> {
+        self.last_batch.clear();
         if prepared.is_empty() {
             return Ok((0, 0));
         }
         let ctx = self.ctx;
         let n = self.config.rendering.vertices;
+        if self.capture_batches {
+            self.last_batch = prepared
+                .iter()
+                .filter(|(_, _, s)| !s.is_empty())
+                .map(|(p, _, s)| {
+                    (
+                        PatchFrame::new(*p, self.planet.radius, n).spacing() as f32,
+                        s.clone(),
+                    )
+                })
+                .collect();
+        }
         let mut bases: Vec<Image> = Vec::with_capacity(prepared.len());
         for (p, _, _) in prepared {
             bases.push(ctx.create_image(&ImageDesc {

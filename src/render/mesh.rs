@@ -54,9 +54,6 @@ mod tests {
             used[i as usize] = true;
         }
         assert!(used.iter().all(|u| *u));
-        assert_eq!(
-            indices.len() as u32,
-            (n - 1) * (n - 1) * 6 + 4 * (n - 1) * 6
-        );
+        assert_eq!(indices.len() as u32, (n - 1) * (n - 1) * 6 + 6 * (n - 1) * 6);
     }
 }

@@ -1,0 +1,380 @@
+//! `riverplanet bench flight`: the scripted flight, rendered headless, with per-frame patches, samples, stage
+//! times, GPU pass times and memory (Figures 9.1-9.8); every frame's new river patches also run through all four
+//! kernel variants so they compare like for like; and the same flight in each water mode.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::{kernel::VariantRunner, path::Flight, Threads};
+use crate::{
+    config::Config,
+    gpu::{vk, Context, GpuError},
+    kernel::{gpu::KernelTuning, KernelParams, PatchJob},
+    render::{
+        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        FrameStats, Renderer, WaterMode,
+    },
+    world::World,
+};
+
+/// The four kernel variants on one frame's new river patches (ms).
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct FrameKernels {
+    pub cpu_single_ms: f64,
+    pub cpu_rayon_ms: f64,
+    pub gpu_simple_ms: f64,
+    pub gpu_tiled_ms: f64,
+    pub gpu_simple_end_to_end_ms: f64,
+    pub gpu_tiled_end_to_end_ms: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FlightFrame {
+    pub altitude: f64,
+    #[serde(flatten)]
+    pub stats: FrameStats,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kernels: Option<FrameKernels>,
+}
+
+/// Averages and maxima over a flight.
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
+pub struct FlightSummary {
+    pub frames: usize,
+    pub average_frame_ms: f64,
+    pub median_frame_ms: f64,
+    pub max_frame_ms: f64,
+    pub average_fps: f64,
+    pub average_visible_patches: f64,
+    pub max_visible_patches: usize,
+    pub average_new_patches: f64,
+    pub max_new_patches: usize,
+    pub average_samples: f64,
+    pub max_samples: usize,
+    pub max_memory_bytes: u64,
+    pub max_patch_texture_bytes: u64,
+    pub max_temporary_sample_bytes: u64,
+    pub max_resident_patches: usize,
+    pub resident_patch_budget: usize,
+    pub average_gpu_ms: BTreeMap<String, f64>,
+    pub average_cpu_ms: BTreeMap<String, f64>,
+    /// Over frames with new river patches: average time of each kernel variant (ms), as Tables 9.1 and 9.2.
+    pub kernel_frames: usize,
+    pub kernel_average_ms: BTreeMap<String, f64>,
+    pub kernel_ratios: BTreeMap<String, f64>,
+    /// Average frame time of the same flight in each water mode.
+    pub water_mode_frame_ms: BTreeMap<String, f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FlightReport {
+    pub device: String,
+    pub driver: String,
+    pub threads: Threads,
+    pub stress: bool,
+    pub seed: u32,
+    pub resolution: [u32; 2],
+    pub switch_factor: f32,
+    pub frames: Vec<FlightFrame>,
+    /// Frame time per frame of the flights in the other water modes.
+    pub water_mode_frames: BTreeMap<String, Vec<f64>>,
+    pub summary: FlightSummary,
+}
+
+/// Options of a flight.
+#[derive(Clone, Debug)]
+pub struct FlightOptions {
+    pub frames: u32,
+    pub stress: bool,
+    pub size: [u32; 2],
+    /// Run every frame's new river patches through all four kernel variants.
+    pub compare_kernels: bool,
+    /// Fly again in the geometry and painted water modes.
+    pub compare_water_modes: bool,
+}
+
+/// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
+pub fn flight_config(config: &Config, stress: bool) -> Config {
+    let mut c = config.clone();
+    if stress {
+        c.rendering.level_of_detail_switch_factor *= 10.0;
+    }
+    c
+}
+
+fn fly(
+    ctx: &Context,
+    world: &World,
+    config: &Config,
+    options: &FlightOptions,
+    water: WaterMode,
+    mut runner: Option<&mut VariantRunner>,
+    mut progress: impl FnMut(u32),
+) -> Result<Vec<FlightFrame>, GpuError> {
+    let [w, h] = options.size;
+    let target = Offscreen::new(ctx, w, h)?;
+    let mut renderer = Renderer::new(
+        ctx,
+        &world.planet,
+        &world.network,
+        config,
+        COLOR_FORMAT,
+        DEPTH_FORMAT,
+    )?;
+    renderer.water_mode = water;
+    renderer.capture_batches = runner.is_some();
+    let params = KernelParams::from_config(config);
+    let flight = Flight::new(world, options.frames, options.stress, w as f64 / h as f64);
+    let mut frames = Vec::with_capacity(options.frames as usize);
+    let mut layout = vk::ImageLayout::UNDEFINED;
+    let result = (|| {
+        for frame in 0..options.frames {
+            let camera = flight.camera(world, frame);
+            let stats = renderer.render(
+                &camera,
+                &target.target([0.02, 0.03, 0.06, 1.0]),
+                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                &[],
+                &[],
+            )?;
+            layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+            let kernels = match (&mut runner, renderer.last_batch.is_empty()) {
+                (Some(runner), false) => {
+                    let jobs: Vec<PatchJob> = renderer
+                        .last_batch
+                        .iter()
+                        .map(|(s, v)| PatchJob {
+                            spacing: *s,
+                            samples: v,
+                        })
+                        .collect();
+                    let (v, _, _) = runner.measure(ctx, &jobs, &params, 1, false)?;
+                    Some(FrameKernels {
+                        cpu_single_ms: v.cpu_single.kernel_ms,
+                        cpu_rayon_ms: v.cpu_rayon.kernel_ms,
+                        gpu_simple_ms: v.gpu_simple.kernel_ms,
+                        gpu_tiled_ms: v.gpu_tiled.kernel_ms,
+                        gpu_simple_end_to_end_ms: v.gpu_simple.end_to_end_ms.unwrap_or(0.0),
+                        gpu_tiled_end_to_end_ms: v.gpu_tiled.end_to_end_ms.unwrap_or(0.0),
+                    })
+                }
+                _ => None,
+            };
+            let altitude = camera.position.length() - world.planet.radius;
+            frames.push(FlightFrame {
+                altitude,
+                stats,
+                kernels,
+            });
+            progress(frame);
+        }
+        Ok(())
+    })();
+    renderer.destroy();
+    target.destroy(ctx);
+    result.map(|()| frames)
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}
+
+fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
+    let stats: Vec<&FrameStats> = frames.iter().map(|f| &f.stats).collect();
+    let frame_ms: Vec<f64> = stats.iter().map(|s| s.frame_ms).collect();
+    let average_frame_ms = mean(frame_ms.iter().copied());
+    let keys = |f: &dyn Fn(&FrameStats) -> &BTreeMap<String, f64>| {
+        let names: std::collections::BTreeSet<&String> =
+            stats.iter().flat_map(|s| f(s).keys()).collect();
+        names
+            .into_iter()
+            .map(|k| {
+                (
+                    k.clone(),
+                    mean(stats.iter().map(|s| f(s).get(k).copied().unwrap_or(0.0))),
+                )
+            })
+            .collect::<BTreeMap<_, _>>()
+    };
+    let kernel_frames: Vec<&FrameKernels> =
+        frames.iter().filter_map(|f| f.kernels.as_ref()).collect();
+    let mut kernel_average_ms = BTreeMap::new();
+    for (name, get) in [
+        (
+            "cpu_single",
+            (|k: &FrameKernels| k.cpu_single_ms) as fn(&FrameKernels) -> f64,
+        ),
+        ("cpu_rayon", |k| k.cpu_rayon_ms),
+        ("gpu_simple", |k| k.gpu_simple_ms),
+        ("gpu_tiled", |k| k.gpu_tiled_ms),
+        ("gpu_simple_end_to_end", |k| k.gpu_simple_end_to_end_ms),
+        ("gpu_tiled_end_to_end", |k| k.gpu_tiled_end_to_end_ms),
+    ] {
+        kernel_average_ms.insert(name.to_string(), mean(kernel_frames.iter().map(|k| get(k))));
+    }
+    let mut kernel_ratios = BTreeMap::new();
+    let avg = |k: &str| kernel_average_ms.get(k).copied().unwrap_or(0.0);
+    if !kernel_frames.is_empty() {
+        kernel_ratios.insert(
+            "tiled_over_simple".into(),
+            avg("gpu_tiled") / avg("gpu_simple"),
+        );
+        kernel_ratios.insert(
+            "cpu_single_over_gpu_tiled".into(),
+            avg("cpu_single") / avg("gpu_tiled"),
+        );
+        kernel_ratios.insert(
+            "cpu_single_over_gpu_tiled_end_to_end".into(),
+            avg("cpu_single") / avg("gpu_tiled_end_to_end"),
+        );
+        kernel_ratios.insert(
+            "cpu_single_over_cpu_rayon".into(),
+            avg("cpu_single") / avg("cpu_rayon"),
+        );
+    }
+    FlightSummary {
+        frames: frames.len(),
+        average_frame_ms,
+        median_frame_ms: super::median(&frame_ms),
+        max_frame_ms: frame_ms.iter().copied().fold(0.0, f64::max),
+        average_fps: if average_frame_ms > 0.0 {
+            1000.0 / average_frame_ms
+        } else {
+            0.0
+        },
+        average_visible_patches: mean(stats.iter().map(|s| s.visible_patches as f64)),
+        max_visible_patches: stats.iter().map(|s| s.visible_patches).max().unwrap_or(0),
+        average_new_patches: mean(stats.iter().map(|s| s.new_patches as f64)),
+        max_new_patches: stats.iter().map(|s| s.new_patches).max().unwrap_or(0),
+        average_samples: mean(stats.iter().map(|s| s.samples as f64)),
+        max_samples: stats.iter().map(|s| s.samples).max().unwrap_or(0),
+        max_memory_bytes: stats.iter().map(|s| s.memory_bytes).max().unwrap_or(0),
+        max_patch_texture_bytes: stats
+            .iter()
+            .map(|s| s.patch_texture_bytes)
+            .max()
+            .unwrap_or(0),
+        max_temporary_sample_bytes: stats
+            .iter()
+            .map(|s| s.temporary_sample_bytes)
+            .max()
+            .unwrap_or(0),
+        max_resident_patches: stats.iter().map(|s| s.resident_patches).max().unwrap_or(0),
+        resident_patch_budget: budget,
+        average_gpu_ms: keys(&|s| &s.gpu_ms),
+        average_cpu_ms: keys(&|s| &s.cpu_ms),
+        kernel_frames: kernel_frames.len(),
+        kernel_average_ms,
+        kernel_ratios,
+        water_mode_frame_ms: BTreeMap::new(),
+    }
+}
+
+/// Flies the scripted path and reports every frame. `progress` is told each finished frame.
+pub fn flight_bench(
+    ctx: &Context,
+    world: &World,
+    options: &FlightOptions,
+    mut progress: impl FnMut(&str, u32),
+) -> Result<FlightReport, GpuError> {
+    let config = flight_config(&world.config, options.stress);
+    let n = config.rendering.vertices;
+    let mut runner = if options.compare_kernels {
+        Some(VariantRunner::new(
+            ctx,
+            config.rendering.new_patches_per_frame as usize + 8,
+            n,
+            KernelTuning::for_device(ctx),
+        )?)
+    } else {
+        None
+    };
+    let frames = fly(
+        ctx,
+        world,
+        &config,
+        options,
+        WaterMode::Auto,
+        runner.as_mut(),
+        |f| progress("auto", f),
+    );
+    if let Some(r) = runner {
+        r.destroy(ctx);
+    }
+    let frames = frames?;
+    let mut summary = summarise(&frames, config.rendering.max_resident_patches as usize);
+    summary
+        .water_mode_frame_ms
+        .insert("auto".into(), summary.average_frame_ms);
+    let mut water_mode_frames = BTreeMap::new();
+    if options.compare_water_modes {
+        for (name, mode) in [
+            ("geometry", WaterMode::Geometry),
+            ("painted", WaterMode::Painted),
+        ] {
+            let other = fly(ctx, world, &config, options, mode, None, |f| {
+                progress(name, f)
+            })?;
+            let times: Vec<f64> = other.iter().map(|f| f.stats.frame_ms).collect();
+            summary
+                .water_mode_frame_ms
+                .insert(name.into(), mean(times.iter().copied()));
+            water_mode_frames.insert(name.to_string(), times);
+        }
+    }
+    Ok(FlightReport {
+        device: ctx.adapter.name.clone(),
+        driver: format!("{} {}", ctx.adapter.driver_name, ctx.adapter.driver_info),
+        threads: Threads::current(),
+        stress: options.stress,
+        seed: world.seed,
+        resolution: options.size,
+        switch_factor: config.rendering.level_of_detail_switch_factor,
+        frames,
+        water_mode_frames,
+        summary,
+    })
+}
+
+/// One CSV row per frame.
+pub fn to_csv(report: &FlightReport) -> String {
+    let mut out = String::from(
+        "frame,altitude,visible_patches,new_patches,river_patches,fallback_patches,samples,frame_ms,gpu_kernel_ms,\
+         gpu_terrain_ms,gpu_water_ms,memory_bytes,patch_texture_bytes,temporary_sample_bytes,resident_patches,\
+         cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms\n",
+    );
+    for f in &report.frames {
+        let s = &f.stats;
+        let g = |k: &str| s.gpu_ms.get(k).copied().unwrap_or(0.0);
+        let k = f.kernels.clone().unwrap_or_default();
+        out.push_str(&format!(
+            "{},{:.3},{},{},{},{},{},{:.3},{:.4},{:.3},{:.3},{},{},{},{},{:.4},{:.4},{:.4},{:.4}\n",
+            s.frame,
+            f.altitude,
+            s.visible_patches,
+            s.new_patches,
+            s.river_patches,
+            s.fallback_patches,
+            s.samples,
+            s.frame_ms,
+            g("kernel"),
+            g("terrain"),
+            g("water"),
+            s.memory_bytes,
+            s.patch_texture_bytes,
+            s.temporary_sample_bytes,
+            s.resident_patches,
+            k.cpu_single_ms,
+            k.cpu_rayon_ms,
+            k.gpu_simple_ms,
+            k.gpu_tiled_ms
+        ));
+    }
+    out
+}

@@ -1,0 +1,304 @@
+//! `riverplanet bench kernel`: the kernel variants on identical input (Tables 9.1 and 9.2). The input is what a
+//! camera descending to the default planet produces: every patch that becomes visible during the scripted flight
+//! and is influenced by a river, with its samples, computed as one batch.
+
+use std::{collections::HashSet, time::Instant};
+
+use serde::Serialize;
+
+use super::{median, path::Flight, Threads};
+use crate::{
+    gpu::{bindless::Bindless, Context, GpuError},
+    kernel::{
+        cpu,
+        gpu::{run_batch, KernelTuning, KernelVariant, RiverKernel},
+        KernelParams, PatchJob, RiverSample, RiverTexel,
+    },
+    river::samples::{patch_samples, PatchFrame},
+    runtime::{
+        cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
+        lod::{select, LodParams},
+    },
+    world::World,
+};
+
+/// Kernel time of one variant: median over repetitions, and for the GPU the end-to-end time too.
+#[derive(Clone, Debug, Serialize)]
+pub struct VariantTiming {
+    pub kernel_ms: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_to_end_ms: Option<f64>,
+    pub runs_ms: Vec<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Variants {
+    pub cpu_single: VariantTiming,
+    pub cpu_rayon: VariantTiming,
+    pub gpu_simple: VariantTiming,
+    pub gpu_tiled: VariantTiming,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Ratios {
+    /// GPU tiled kernel time / GPU simple kernel time (the thesis: 0.82 in Table 9.1, 0.68 in Table 9.2).
+    pub tiled_over_simple: f64,
+    /// CPU single-threaded time / GPU tiled end-to-end time (how much faster the GPU path is).
+    pub cpu_single_over_gpu_tiled_end_to_end: f64,
+    /// CPU single-threaded time / GPU tiled kernel time.
+    pub cpu_single_over_gpu_tiled_kernel: f64,
+    pub cpu_single_over_cpu_rayon: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct KernelReport {
+    pub device: String,
+    pub driver: String,
+    pub workload: String,
+    pub stress: bool,
+    pub seed: u32,
+    pub flight_frames: u32,
+    pub patches: usize,
+    pub samples: usize,
+    /// Vertex-sample pairs the procedures visit.
+    pub pairs: u64,
+    /// Pairs within the influence distance: the ones Procedure 3 does real work for.
+    pub relevant_pairs: u64,
+    pub height_range: [f32; 2],
+    pub max_abs_diff: f32,
+    /// `max_abs_diff` relative to the height range.
+    pub relative_diff: f32,
+    pub repetitions: usize,
+    pub tuning: KernelTuning,
+    pub threads: Threads,
+    pub variants: Variants,
+    pub ratios: Ratios,
+}
+
+/// The patches and samples a scripted flight produces: every visible patch that a river influences, once, in
+/// the order the flight meets them. `stress` uses the thesis's stress settings (switch factor x10, camera x25).
+pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Vec<RiverSample>)> {
+    let config = &world.config;
+    let n = config.rendering.vertices;
+    let radius = world.planet.radius;
+    let factor = if stress { 10.0 } else { 1.0 };
+    let params = LodParams {
+        radius,
+        switch_factor: config.rendering.level_of_detail_switch_factor as f64 * factor,
+        max_level: config.rendering.max_level_of_detail,
+    };
+    let heights = HeightRange {
+        min: world.planet.stats.min_height as f64 - 1.0,
+        max: world.planet.stats.max_height as f64 + config.river.basin_depth as f64 + 1.0,
+    };
+    let flight = Flight::new(world, frames, stress, 16.0 / 9.0);
+    let mut seen = HashSet::new();
+    let mut out = Vec::new();
+    for frame in 0..frames {
+        let camera = flight.camera(world, frame);
+        let frustum = Frustum::from_matrix(camera.clip());
+        for s in select(camera.position, &params) {
+            let (c, r) = bounding_sphere(s.patch, radius, heights);
+            if beyond_horizon(s.patch, camera.position, radius, heights)
+                || !frustum.touches_sphere(c, r)
+            {
+                continue;
+            }
+            if !seen.insert(s.patch) {
+                continue;
+            }
+            let frame = PatchFrame::new(s.patch, radius, n);
+            let samples = patch_samples(&world.network, &frame);
+            if !samples.is_empty() {
+                out.push((frame.spacing() as f32, samples));
+            }
+        }
+    }
+    out
+}
+
+fn max_abs_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| {
+            [
+                (x.terrain_height - y.terrain_height).abs(),
+                (x.lerp_factor - y.lerp_factor).abs(),
+                (x.water_height - y.water_height).abs(),
+                (x.min_distance - y.min_distance).abs(),
+                (x.river_width - y.river_width).abs(),
+            ]
+            .into_iter()
+            .fold(0.0f32, f32::max)
+        })
+        .fold(0.0, f32::max)
+}
+
+fn count_relevant_pairs(jobs: &[PatchJob], n: u32, params: &KernelParams) -> u64 {
+    jobs.iter()
+        .map(|job| {
+            (0..n * n)
+                .map(|k| {
+                    let v = crate::kernel::vertex_position(k % n, k / n, job.spacing);
+                    job.samples
+                        .iter()
+                        .filter(|s| cpu::calculate_height_by_sample(v, s, params).is_some())
+                        .count() as u64
+                })
+                .sum::<u64>()
+        })
+        .sum()
+}
+
+/// Runs the four variants on the same jobs; keeps its GPU pipelines between measurements.
+pub struct VariantRunner {
+    bindless: Bindless,
+    kernel: RiverKernel,
+}
+
+impl VariantRunner {
+    /// A runner for batches of up to `capacity` patches of `n x n` vertices.
+    pub fn new(
+        ctx: &Context,
+        capacity: usize,
+        n: u32,
+        tuning: KernelTuning,
+    ) -> Result<Self, GpuError> {
+        let bindless = Bindless::new(ctx, capacity as u32 + 16)?;
+        let kernel = RiverKernel::new(ctx, &bindless, n, tuning)?;
+        Ok(Self { bindless, kernel })
+    }
+
+    /// Times CPU single-thread, CPU rayon, GPU simple and GPU tiled; `repetitions` runs each (after one warm-up
+    /// run for the GPU). Returns the timings, the CPU reference output, and the largest difference to it.
+    pub fn measure(
+        &mut self,
+        ctx: &Context,
+        jobs: &[PatchJob],
+        params: &KernelParams,
+        repetitions: usize,
+        warm_up: bool,
+    ) -> Result<(Variants, Vec<Vec<RiverTexel>>, f32), GpuError> {
+        let n = self.kernel.grid_size;
+        let repetitions = repetitions.max(1);
+        let time = |f: &mut dyn FnMut()| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        };
+        let mut reference = Vec::new();
+        let cpu_single: Vec<f64> = (0..repetitions)
+            .map(|_| time(&mut || reference = cpu::compute_patches(jobs, n, params)))
+            .collect();
+        let cpu_rayon: Vec<f64> = (0..repetitions)
+            .map(|_| time(&mut || drop(cpu::compute_patches_rayon(jobs, n, params))))
+            .collect();
+        let mut max_diff = 0.0f32;
+        let mut gpu = |variant| -> Result<VariantTiming, GpuError> {
+            if warm_up {
+                run_batch(ctx, &mut self.bindless, &self.kernel, variant, jobs, params)?;
+            }
+            let (mut kernel_ms, mut end_to_end) = (Vec::new(), Vec::new());
+            for _ in 0..repetitions {
+                let t = Instant::now();
+                let result =
+                    run_batch(ctx, &mut self.bindless, &self.kernel, variant, jobs, params)?;
+                end_to_end.push(t.elapsed().as_secs_f64() * 1e3);
+                kernel_ms.push(result.timings.iter().map(|s| s.ms).sum());
+                max_diff = max_diff.max(max_abs_diff(&reference, &result.texels));
+            }
+            Ok(VariantTiming {
+                kernel_ms: median(&kernel_ms),
+                end_to_end_ms: Some(median(&end_to_end)),
+                runs_ms: kernel_ms,
+            })
+        };
+        let gpu_simple = gpu(KernelVariant::Simple)?;
+        let gpu_tiled = gpu(KernelVariant::Tiled)?;
+        let cpu = |runs: Vec<f64>| VariantTiming {
+            kernel_ms: median(&runs),
+            end_to_end_ms: None,
+            runs_ms: runs,
+        };
+        let variants = Variants {
+            cpu_single: cpu(cpu_single),
+            cpu_rayon: cpu(cpu_rayon),
+            gpu_simple,
+            gpu_tiled,
+        };
+        Ok((variants, reference, max_diff))
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.kernel.destroy(ctx);
+        let _ = ctx.wait_idle();
+        self.bindless.destroy(ctx);
+    }
+}
+
+/// `riverplanet bench kernel`.
+pub fn kernel_bench(
+    ctx: &Context,
+    world: &World,
+    stress: bool,
+    frames: u32,
+    repetitions: usize,
+    tuning: KernelTuning,
+) -> Result<KernelReport, GpuError> {
+    let params = KernelParams::from_config(&world.config);
+    let n = world.config.rendering.vertices;
+    let patches = flight_workload(world, stress, frames);
+    let jobs: Vec<PatchJob> = patches
+        .iter()
+        .map(|(s, v)| PatchJob {
+            spacing: *s,
+            samples: v,
+        })
+        .collect();
+    let mut runner = VariantRunner::new(ctx, jobs.len(), n, tuning)?;
+    let measured = runner.measure(ctx, &jobs, &params, repetitions, true);
+    runner.destroy(ctx);
+    let (variants, reference, max_abs_diff) = measured?;
+    let heights = reference.iter().flatten().map(|t| t.terrain_height);
+    let height_range = heights.fold([f32::MAX, f32::MIN], |[lo, hi], h| [lo.min(h), hi.max(h)]);
+    let ratios = Ratios {
+        tiled_over_simple: variants.gpu_tiled.kernel_ms / variants.gpu_simple.kernel_ms,
+        cpu_single_over_gpu_tiled_end_to_end: variants.cpu_single.kernel_ms
+            / variants.gpu_tiled.end_to_end_ms.unwrap_or(f64::NAN),
+        cpu_single_over_gpu_tiled_kernel: variants.cpu_single.kernel_ms
+            / variants.gpu_tiled.kernel_ms,
+        cpu_single_over_cpu_rayon: variants.cpu_single.kernel_ms / variants.cpu_rayon.kernel_ms,
+    };
+    Ok(KernelReport {
+        device: ctx.adapter.name.clone(),
+        driver: format!("{} {}", ctx.adapter.driver_name, ctx.adapter.driver_info),
+        workload: format!(
+            "every river patch met by the scripted flight ({frames} frames{}) over seed {}",
+            if stress {
+                ", stress: switch factor x10, camera x25"
+            } else {
+                ""
+            },
+            world.seed
+        ),
+        stress,
+        seed: world.seed,
+        flight_frames: frames,
+        patches: jobs.len(),
+        samples: jobs.iter().map(|j| j.samples.len()).sum(),
+        pairs: jobs
+            .iter()
+            .map(|j| j.samples.len() as u64 * (n * n) as u64)
+            .sum(),
+        relevant_pairs: count_relevant_pairs(&jobs, n, &params),
+        height_range,
+        max_abs_diff,
+        relative_diff: max_abs_diff / (height_range[1] - height_range[0]).max(1e-6),
+        repetitions,
+        tuning,
+        threads: Threads::current(),
+        variants,
+        ratios,
+    })
+}

@@ -1,0 +1,76 @@
+//! The scripted camera of the experiments (Section 9.2): from orbit down to a river, then low along it towards the
+//! sea. The stress test (9.2) moves the camera 25 times faster: the descent is over after a 25th of the frames and
+//! the low flight covers 25 times the distance.
+
+use glam::DVec3;
+
+use crate::{runtime::camera::Camera, world::World};
+
+/// A flight of `frames` frames over `world`.
+#[derive(Clone, Debug)]
+pub struct Flight {
+    start: DVec3,
+    end: DVec3,
+    radius: f64,
+    frames: u32,
+    speed: f64,
+    aspect: f64,
+}
+
+/// Where the descent starts and ends: 3.5 radii from the centre, and 6 units above the ground.
+const START_ALTITUDE_RADII: f64 = 2.5;
+const END_ALTITUDE: f64 = 6.0;
+/// Share of an unstressed flight spent descending.
+const DESCENT: f64 = 0.6;
+
+impl Flight {
+    pub fn new(world: &World, frames: u32, stress: bool, aspect: f64) -> Self {
+        let (start, end) = match world.network.systems.first() {
+            Some(s) => (s.source, s.mouth),
+            None => (DVec3::Z, DVec3::new(0.3, 0.0, 1.0).normalize()),
+        };
+        Self {
+            start,
+            end,
+            radius: world.planet.radius,
+            frames: frames.max(1),
+            speed: if stress { 25.0 } else { 1.0 },
+            aspect,
+        }
+    }
+
+    /// The camera at `frame`.
+    pub fn camera(&self, world: &World, frame: u32) -> Camera {
+        let s = frame as f64 / self.frames as f64 * self.speed;
+        let descent = (s / DESCENT).min(1.0);
+        // Along the great circle from the source towards the mouth (and beyond, for long flights).
+        let axis = self
+            .start
+            .cross(self.end)
+            .try_normalize()
+            .unwrap_or(DVec3::Y);
+        let span = self.start.angle_between(self.end).max(0.05);
+        let travel = span * (0.3 * descent + ((s - DESCENT).max(0.0) / (1.0 - DESCENT)) * 0.7);
+        let rotate = |angle: f64| glam::DQuat::from_axis_angle(axis, angle);
+        let here = rotate(travel) * self.start;
+        let ground = self.radius + world.planet.height_at(here).max(world.planet.sea_level) as f64;
+        let high = self.radius * START_ALTITUDE_RADII;
+        let altitude = high * (END_ALTITUDE / high).powf(descent);
+        let eye = here * (ground + altitude);
+        // From looking at the planet's centre to looking ahead along the flight, tilted down.
+        let ahead = rotate(travel + span * 0.2) * self.start * ground;
+        let target = DVec3::ZERO.lerp(ahead, descent.powf(0.5));
+        let target = if (target - eye).length() < 1e-6 {
+            DVec3::ZERO
+        } else {
+            target
+        };
+        Camera::look_at(
+            eye,
+            target,
+            60.0,
+            self.aspect,
+            (altitude * 0.05).clamp(0.01, 10.0),
+        )
+    }
+}

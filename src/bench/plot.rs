@@ -1,0 +1,274 @@
+//! `riverplanet plot`: the figures of Chapter 9 from the JSON of `bench flight`, as SVG and PNG (plotters; text
+//! in DejaVu Sans from the system, which tools/setup installs).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+use serde_json::Value;
+
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    #[error("cannot read {path}: {message}")]
+    Read { path: String, message: String },
+    #[error("{path} is not a `bench flight` report: {message}")]
+    Format { path: String, message: String },
+    #[error("cannot draw {path}: {message}")]
+    Draw { path: String, message: String },
+    #[error("no font for the plots: {0} (install fonts-dejavu-core)")]
+    Font(String),
+}
+
+const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+fn register_font() -> Result<(), PlotError> {
+    static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    DONE.get_or_init(|| {
+        let bytes = std::fs::read(FONT).map_err(|e| format!("{FONT}: {e}"))?;
+        let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+        plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
+            .map_err(|_| format!("{FONT}: invalid"))
+    })
+    .clone()
+    .map_err(PlotError::Font)
+}
+
+/// One line of a chart.
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A line chart over frames, written to `base.svg` and `base.png`.
+pub fn line_chart(
+    base: &Path,
+    title: &str,
+    y_label: &str,
+    series: &[Series],
+) -> Result<(), PlotError> {
+    register_font()?;
+    let draw_err = |e: &dyn std::fmt::Display| PlotError::Draw {
+        path: base.display().to_string(),
+        message: e.to_string(),
+    };
+    let x_max = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .fold(1.0, f64::max);
+    let y_max = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(0.0, f64::max)
+        .max(1e-6)
+        * 1.08;
+    let colours = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+    ];
+    let (w, h) = (960u32, 540u32);
+    macro_rules! draw {
+        ($backend:expr) => {{
+            let root = $backend.into_drawing_area();
+            root.fill(&WHITE).map_err(|e| draw_err(&e))?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(title, ("sans-serif", 22))
+                .margin(16)
+                .x_label_area_size(40)
+                .y_label_area_size(70)
+                .build_cartesian_2d(0.0..x_max, 0.0..y_max)
+                .map_err(|e| draw_err(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc("frame")
+                .y_desc(y_label)
+                .label_style(("sans-serif", 14))
+                .draw()
+                .map_err(|e| draw_err(&e))?;
+            for (k, s) in series.iter().enumerate() {
+                let colour = colours[k % colours.len()];
+                chart
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied(),
+                        colour.stroke_width(2),
+                    ))
+                    .map_err(|e| draw_err(&e))?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
+                    });
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 14))
+                .draw()
+                .map_err(|e| draw_err(&e))?;
+            root.present().map_err(|e| draw_err(&e))?;
+        }};
+    }
+    let svg = base.with_extension("svg");
+    draw!(SVGBackend::new(&svg, (w, h)));
+    let mut pixels = vec![0u8; (w * h * 3) as usize];
+    draw!(BitMapBackend::with_buffer(&mut pixels, (w, h)));
+    image::RgbImage::from_raw(w, h, pixels)
+        .ok_or_else(|| draw_err(&"buffer size"))?
+        .save(base.with_extension("png"))
+        .map_err(|e| draw_err(&e))
+}
+
+fn read(path: &Path) -> Result<Value, PlotError> {
+    let text = std::fs::read_to_string(path).map_err(|e| PlotError::Read {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let value: Value = serde_json::from_str(&text).map_err(|e| PlotError::Format {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    if !value["frames"].is_array() {
+        return Err(PlotError::Format {
+            path: path.display().to_string(),
+            message: "no `frames` array".into(),
+        });
+    }
+    Ok(value)
+}
+
+fn series(frames: &[Value], name: &str, f: impl Fn(&Value) -> Option<f64>) -> Series {
+    Series {
+        name: name.to_string(),
+        points: frames
+            .iter()
+            .enumerate()
+            .filter_map(|(k, v)| f(v).map(|y| (k as f64, y)))
+            .collect(),
+    }
+}
+
+/// Writes the figures of one flight report into `out` with file names starting with `prefix`: returns the base
+/// names written.
+pub fn flight_figures(
+    report: &Path,
+    out: &Path,
+    prefix: &str,
+    stress: bool,
+) -> Result<Vec<String>, PlotError> {
+    let value = read(report)?;
+    let frames = value["frames"].as_array().cloned().unwrap_or_default();
+    std::fs::create_dir_all(out).map_err(|e| PlotError::Draw {
+        path: out.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let k = |key: &'static str| move |v: &Value| v["kernels"][key].as_f64();
+    let g = |key: &'static str| move |v: &Value| Some(v["gpu_ms"][key].as_f64().unwrap_or(0.0));
+    let num = |key: &'static str| move |v: &Value| v[key].as_f64();
+    let mb = |key: &'static str| move |v: &Value| v[key].as_f64().map(|b| b / 1e6);
+    let (f1, f2, f3, f4) = if stress {
+        ("9_6", "9_5", "9_7", "9_8")
+    } else {
+        ("9_1", "9_2", "9_3", "9_4")
+    };
+    let label = if stress { " (stress test)" } else { "" };
+    let mut written = Vec::new();
+    let mut chart =
+        |name: String, title: String, y: &str, s: Vec<Series>| -> Result<(), PlotError> {
+            line_chart(&out.join(&name), &title, y, &s)?;
+            written.push(name);
+            Ok(())
+        };
+    chart(
+        format!("{prefix}fig{f1}_cpu_vs_gpu"),
+        format!("Kernel time per frame: CPU vs GPU{label}"),
+        "ms",
+        vec![
+            series(&frames, "CPU single thread", k("cpu_single_ms")),
+            series(&frames, "CPU rayon", k("cpu_rayon_ms")),
+            series(&frames, "GPU tiled (kernel)", k("gpu_tiled_ms")),
+            series(
+                &frames,
+                "GPU tiled (end to end)",
+                k("gpu_tiled_end_to_end_ms"),
+            ),
+        ],
+    )?;
+    chart(
+        format!("{prefix}fig{f2}a_patches"),
+        format!("Patches per frame{label}"),
+        "patches",
+        vec![
+            series(&frames, "new patches", num("new_patches")),
+            series(&frames, "new river patches", num("river_patches")),
+            series(&frames, "visible patches", num("visible_patches")),
+        ],
+    )?;
+    chart(
+        format!("{prefix}fig{f2}b_samples"),
+        format!("Samples per frame / 100{label}"),
+        "samples / 100",
+        vec![series(&frames, "samples / 100", |v| {
+            v["samples"].as_f64().map(|s| s / 100.0)
+        })],
+    )?;
+    chart(
+        format!("{prefix}fig{f3}_simple_vs_tiled"),
+        format!("GPU kernel time: simple vs tiled (kernel only){label}"),
+        "ms",
+        vec![
+            series(&frames, "simple", k("gpu_simple_ms")),
+            series(&frames, "tiled", k("gpu_tiled_ms")),
+        ],
+    )?;
+    chart(
+        format!("{prefix}fig{f4}_memory"),
+        format!(
+            "Memory per frame{label} (plus {:.1} MB of precomputed heights)",
+            frames
+                .first()
+                .and_then(|f| f["precomputed_height_bytes"].as_f64())
+                .unwrap_or(0.0)
+                / 1e6
+        ),
+        "MB",
+        vec![
+            series(&frames, "patch textures", mb("patch_texture_bytes")),
+            series(
+                &frames,
+                "temporary sample data",
+                mb("temporary_sample_bytes"),
+            ),
+        ],
+    )?;
+    let mut water = vec![series(&frames, "auto", num("frame_ms"))];
+    if let Some(modes) = value["water_mode_frames"].as_object() {
+        for (mode, times) in modes {
+            let times = times.as_array().cloned().unwrap_or_default();
+            water.push(Series {
+                name: mode.clone(),
+                points: times
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(k, t)| t.as_f64().map(|t| (k as f64, t)))
+                    .collect(),
+            });
+        }
+    }
+    chart(
+        format!("{prefix}frame_time_by_water_mode"),
+        format!("Frame time per water mode{label}"),
+        "ms",
+        water,
+    )?;
+    chart(
+        format!("{prefix}gpu_passes"),
+        format!("GPU time per pass{label}"),
+        "ms",
+        vec![
+            series(&frames, "kernel", g("kernel")),
+            series(&frames, "terrain", g("terrain")),
+            series(&frames, "water", g("water")),
+        ],
+    )?;
+    Ok(written)
+}
