@@ -3,13 +3,20 @@
 // onto the sphere; normals from neighbouring heights; skirts below the patch edges close cracks between levels.
 #include "terrain_common.glsl"
 
+layout(constant_id = 0) const uint WATER_PASS = 0;
+
+// Locations 0-5 and 9 are what the fragment shader reads (directly in the terrain pass, through the geometry
+// shader in the water pass); 6-8 are for the geometry shader.
 layout(location = 0) out vec3 vPosition;    // camera-relative
 layout(location = 1) out vec3 vNormal;
-layout(location = 2) out vec3 vDirection;   // unit direction from the planet centre
-layout(location = 3) out vec4 vRiver;       // final height, water height, signed distance, river half width
-layout(location = 4) out vec2 vGrid;        // (i, j) within the patch
-layout(location = 5) flat out int vInstance;
-layout(location = 6) flat out int vSkirt;       // -1 surface, 0-3 edge skirts, 4-5 midline skirts
+layout(location = 2) out vec4 vRiver;       // final height, water height, signed distance, river half width
+layout(location = 3) flat out int vRiverWater;
+layout(location = 4) flat out float vLevel;
+layout(location = 5) out vec3 vDirection;   // unit direction from the planet centre
+layout(location = 6) out vec2 vGrid;        // (i, j) within the patch
+layout(location = 7) flat out int vInstance;
+layout(location = 8) flat out int vSkirt;   // -1 surface, 0-3 edge skirts, 4-5 midline skirts
+layout(location = 9) flat out float vSpacing;
 
 const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
 const vec3 FACE_U[6] = vec3[](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0), vec3(1, 0, 0), vec3(1, 0, 0), vec3(-1, 0, 0));
@@ -20,6 +27,16 @@ vec3 directionAt(PatchInstance p, vec2 grid) {
     vec2 uv = p.uvRect.xy + grid / (n - 1.0) * p.uvRect.z;
     int face = int(p.uvRect.w);
     return normalize(FACE_NORMAL[face] + uv.x * FACE_U[face] + uv.y * FACE_V[face]);
+}
+
+// The blended terrain height at a grid position (for normals: two texture reads).
+float heightAt(PatchInstance p, vec2 grid) {
+    float n = frame.planet.y;
+    vec2 t = p.texRect.xy + grid * p.texRect.z;
+    float base = textureLod(patchTextures[nonuniformEXT(p.slots.x)], vec3((t + 1.5) / (n + 2.0), 0.0), 0.0).r;
+    if (p.slots.y < 0) return base;
+    vec2 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3((t + 0.5) / n, 0.0), 0.0).xy;
+    return mix(river.x, base, river.y);
 }
 
 // River data and base height at a grid position, read from the patch's (or its stand-in's) textures.
@@ -66,18 +83,19 @@ void main() {
     if (skirt) height -= frame.extra.x * p.centreDir.w;
     vec3 position = positionAt(p, grid, height, direction);
 
-    // Normal from the four neighbours (clamped to the patch; the base texture's border keeps edges smooth).
-    vec3 neighbour[4];
-    vec2 offsets[4] = vec2[](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1));
-    for (int k = 0; k < 4; ++k) {
-        vec2 g = clamp(grid + offsets[k], vec2(0.0), vec2(n - 1));
-        float b;
-        vec4 s = surfaceAt(p, g, b);
-        vec3 d = directionAt(p, g);
-        neighbour[k] = positionAt(p, g, s.x, d);
+    // Normal from the four neighbours (clamped to the patch; the base texture's border keeps edges smooth). The
+    // water pass needs none: water is level.
+    vec3 normal = direction;
+    if (WATER_PASS == 0) {
+        vec3 neighbour[4];
+        vec2 offsets[4] = vec2[](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1));
+        for (int k = 0; k < 4; ++k) {
+            vec2 g = clamp(grid + offsets[k], vec2(0.0), vec2(n - 1));
+            neighbour[k] = positionAt(p, g, heightAt(p, g), directionAt(p, g));
+        }
+        normal = normalize(cross(neighbour[0] - neighbour[1], neighbour[2] - neighbour[3]));
+        if (dot(normal, direction) < 0.0) normal = -normal;
     }
-    vec3 normal = normalize(cross(neighbour[0] - neighbour[1], neighbour[2] - neighbour[3]));
-    if (dot(normal, direction) < 0.0) normal = -normal;
 
     vPosition = position;
     vNormal = normal;
@@ -86,5 +104,8 @@ void main() {
     vGrid = grid;
     vInstance = gl_InstanceIndex;
     vSkirt = edge;
+    vRiverWater = 0;
+    vLevel = p.centreRel.w;
+    vSpacing = p.centreDir.w;
     gl_Position = frame.viewProjection * vec4(position, 1.0);
 }

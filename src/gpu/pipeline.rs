@@ -421,16 +421,19 @@ impl Recorder<'_> {
         unsafe { self.ctx().device.cmd_end_rendering(self.cmd) };
     }
 
-    /// Draws `instances` instances of the indexed mesh in `indices` (u32) with `pipeline`.
+    /// Draws the instances `instances` of the indexed mesh range `range` of `indices` (u32) with `pipeline`.
     pub fn draw_indexed(
         &mut self,
         pipeline: &GraphicsPipeline,
         sets: &[vk::DescriptorSet],
         push: &[u8],
         indices: &super::Buffer,
-        index_count: u32,
-        instances: u32,
+        range: std::ops::Range<u32>,
+        instances: std::ops::Range<u32>,
     ) {
+        if range.is_empty() || instances.is_empty() {
+            return;
+        }
         let device = &self.ctx().device;
         let stages = vk::ShaderStageFlags::VERTEX
             | vk::ShaderStageFlags::GEOMETRY
@@ -450,7 +453,14 @@ impl Recorder<'_> {
                 device.cmd_push_constants(self.cmd, pipeline.layout, stages, 0, push);
             }
             device.cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32);
-            device.cmd_draw_indexed(self.cmd, index_count, instances, 0, 0, 0);
+            device.cmd_draw_indexed(
+                self.cmd,
+                range.end - range.start,
+                instances.end - instances.start,
+                range.start,
+                0,
+                instances.start,
+            );
         }
     }
 }

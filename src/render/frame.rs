@@ -8,7 +8,7 @@ use glam::{DMat4, DVec3};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::mesh::patch_indices;
+use super::mesh::{patch_mesh, PatchMesh};
 use crate::{
     config::Config,
     gpu::{
@@ -137,7 +137,8 @@ pub struct Renderer<'w> {
     wireframe: GraphicsPipeline,
     instance_layout: BufferSetLayout,
     indices: Buffer,
-    index_count: u32,
+    quadrant_ranges: [std::ops::Range<u32>; 4],
+    all_indices: std::ops::Range<u32>,
     cache: PatchCache,
     profiler: Profiler,
     params: KernelParams,
@@ -174,13 +175,15 @@ impl<'w> Renderer<'w> {
         let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
         let instance_layout = BufferSetLayout::new(ctx, 1, "patch instances")?;
         let layouts = [bindless.layout, instance_layout.layout];
+        // The terrain is drawn per quadrant without a geometry shader; the water pass has the geometry shader that
+        // spawns water triangles (docs/rendering.md).
         let pipeline = |name: &str, water: bool, wireframe: bool| {
             GraphicsPipeline::new(
                 ctx,
                 &GraphicsDesc {
                     name,
                     vertex: shaders::TERRAIN_VERT,
-                    geometry: Some(shaders::TERRAIN_GEOM),
+                    geometry: water.then_some(shaders::TERRAIN_GEOM),
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
                     push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
@@ -197,7 +200,10 @@ impl<'w> Renderer<'w> {
         let terrain = pipeline("terrain", false, false)?;
         let water = pipeline("water", true, false)?;
         let wireframe = pipeline("terrain wireframe", false, true)?;
-        let mesh = patch_indices(n);
+        let PatchMesh {
+            indices: mesh,
+            quadrants,
+        } = patch_mesh(n);
         let indices = ctx.create_buffer(&BufferDesc {
             name: "patch mesh indices",
             size: (mesh.len() * 4) as u64,
@@ -224,7 +230,8 @@ impl<'w> Renderer<'w> {
             wireframe,
             instance_layout,
             indices,
-            index_count: mesh.len() as u32,
+            quadrant_ranges: quadrants,
+            all_indices: 0..mesh.len() as u32,
             cache: PatchCache::new(capacity),
             profiler,
             params: KernelParams::from_config(config),
@@ -341,22 +348,41 @@ impl<'w> Renderer<'w> {
         stats.temporary_sample_bytes = bytes;
         stats.river_patches = river_patches;
 
-        // Instances: every visible patch, with its own data or the part of its nearest resident ancestor.
-        let instances: Vec<PatchInstance> = visible
-            .iter()
-            .filter_map(|s| {
-                let (source, own) = if self.cache.contains(&s.patch) {
-                    (s.patch, true)
-                } else {
-                    (self.cache.resident_ancestor(s.patch)?, false)
-                };
-                if !own {
-                    stats.fallback_patches += 1;
+        // Instances: every visible patch, with its own data or the part of its nearest resident ancestor. One list
+        // per quadrant for the terrain (the instances that draw it), then one for the water (patches with a river
+        // or below sea level), all in one buffer.
+        let mut drawn: Vec<(PatchInstance, bool)> = Vec::with_capacity(visible.len());
+        for s in &visible {
+            let source = if self.cache.contains(&s.patch) {
+                s.patch
+            } else {
+                stats.fallback_patches += 1;
+                match self.cache.resident_ancestor(s.patch) {
+                    Some(a) => a,
+                    None => continue,
                 }
-                let data = self.cache.touch(&source)?;
-                Some(instance(s, source, data, camera.position, radius, n))
-            })
-            .collect();
+            };
+            let Some(data) = self.cache.touch(&source) else {
+                continue;
+            };
+            let wet = data.river.is_some() || data.min_height < self.planet.sea_level;
+            drawn.push((instance(s, source, data, camera.position, radius, n), wet));
+        }
+        let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 3);
+        let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
+        for (q, range) in quadrant_instances.iter_mut().enumerate() {
+            let first = instances.len() as u32;
+            instances.extend(
+                drawn
+                    .iter()
+                    .filter(|(i, _)| i.slots[2] & (1 << q) != 0)
+                    .map(|(i, _)| *i),
+            );
+            *range = first..instances.len() as u32;
+        }
+        let first = instances.len() as u32;
+        instances.extend(drawn.iter().filter(|(_, wet)| *wet).map(|(i, _)| *i));
+        let water_instances = first..instances.len() as u32;
         let instance_buffer = {
             let mut buffer = ctx.create_buffer(&BufferDesc {
                 name: "patch instances",
@@ -429,33 +455,33 @@ impl<'w> Renderer<'w> {
         );
         rec.begin_rendering(target, true);
         let sets = [self.bindless.set, instance_set];
-        let count = instances.len() as u32;
+        let push = bytemuck::bytes_of(&push);
         let scope = self.profiler.begin(&mut rec, "terrain")?;
         let terrain = if self.wireframe_on {
             &self.wireframe
         } else {
             &self.terrain
         };
-        if count > 0 {
+        for (indices, instances) in self.quadrant_ranges.iter().zip(&quadrant_instances) {
             rec.draw_indexed(
                 terrain,
                 &sets,
-                bytemuck::bytes_of(&push),
+                push,
                 &self.indices,
-                self.index_count,
-                count,
+                indices.clone(),
+                instances.clone(),
             );
         }
         self.profiler.end(&mut rec, scope);
         let scope = self.profiler.begin(&mut rec, "water")?;
-        if count > 0 && !self.wireframe_on {
+        if !self.wireframe_on {
             rec.draw_indexed(
                 &self.water,
                 &sets,
-                bytemuck::bytes_of(&push),
+                push,
                 &self.indices,
-                self.index_count,
-                count,
+                self.all_indices.clone(),
+                water_instances,
             );
         }
         self.profiler.end(&mut rec, scope);
@@ -617,7 +643,7 @@ impl<'w> Renderer<'w> {
         }
         let river_count = rivers.len();
         let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();
-        for (((p, _, s), base), river) in prepared.iter().zip(bases).zip(river_of) {
+        for (((p, heights, s), base), river) in prepared.iter().zip(bases).zip(river_of) {
             let slot = self.slot()?;
             self.bindless.write(
                 ctx,
@@ -627,8 +653,9 @@ impl<'w> Renderer<'w> {
                 vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             );
             let river = river.and_then(|k| rivers[k].take());
+            let min_height = heights.iter().copied().fold(f32::MAX, f32::min);
             self.cache
-                .insert(*p, PatchData::new(base, slot, river, s.len()));
+                .insert(*p, PatchData::new(base, slot, river, s.len(), min_height));
         }
         Ok((bytes, river_count))
     }

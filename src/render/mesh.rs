@@ -1,16 +1,29 @@
-//! The one patch mesh (Section 3.3): an n x n grid of vertices, two triangles per cell, plus a skirt along each
-//! edge (a strip hanging below the edge) that hides cracks between patches of different levels. Vertices carry no
-//! attributes: the vertex shader derives (i, j) from the index (grid vertices first, then 4 x n skirt vertices:
-//! south, north, west, east edges, then 2 x n skirt vertices along the vertical and horizontal midlines). The
-//! midline skirts close the cracks between a patch's drawn quadrants and the finer patches beside them; the
-//! geometry shader draws them only beside a drawn quadrant.
+//! The one patch mesh (Section 3.3): an n x n grid of vertices, two triangles per cell, plus skirts: strips hanging
+//! below the four edges and the two midlines that hide cracks between patches of different levels. Vertices carry
+//! no attributes: the vertex shader derives (i, j) from the index (grid vertices first, then n skirt vertices for
+//! each of: south, north, west, east edge, vertical midline, horizontal midline).
+//!
+//! Indices are grouped by quadrant, so that the terrain pass draws each quadrant as its own instanced range (only
+//! the instances that draw that quadrant) without a geometry shader. A midline skirt segment belongs to both
+//! quadrants beside it: it closes the crack towards finer patches on the other side, and hides under the surface
+//! when both sides are drawn.
 
-/// Indices of the grid and skirt triangles.
-pub fn patch_indices(n: u32) -> Vec<u32> {
+use std::ops::Range;
+
+/// The index buffer and the range of each quadrant in it (bit 0: +i half, bit 1: +j half). The whole buffer is
+/// every triangle at least once (midline skirts twice).
+pub struct PatchMesh {
+    pub indices: Vec<u32>,
+    pub quadrants: [Range<u32>; 4],
+}
+
+/// Builds the mesh for `n x n` vertices (n = 2^k + 1).
+pub fn patch_mesh(n: u32) -> PatchMesh {
     let grid = |i: u32, j: u32| j * n + i;
     let skirt = |edge: u32, k: u32| n * n + edge * n + k;
     let m = (n - 1) / 2;
-    let mut out = Vec::with_capacity(((n - 1) * (n - 1) * 6 + 6 * (n - 1) * 6) as usize);
+    let half = |k: u32| (k >= m) as u32;
+    let mut lists: [Vec<u32>; 4] = Default::default();
     for j in 0..n - 1 {
         for i in 0..n - 1 {
             let (a, b, c, d) = (
@@ -19,24 +32,43 @@ pub fn patch_indices(n: u32) -> Vec<u32> {
                 grid(i, j + 1),
                 grid(i + 1, j + 1),
             );
-            out.extend_from_slice(&[a, b, d, a, d, c]);
+            lists[(half(i) | half(j) << 1) as usize].extend_from_slice(&[a, b, d, a, d, c]);
         }
     }
     for k in 0..n - 1 {
-        let edges = [
-            (grid(k, 0), grid(k + 1, 0), 0),
-            (grid(k, n - 1), grid(k + 1, n - 1), 1),
-            (grid(0, k), grid(0, k + 1), 2),
-            (grid(n - 1, k), grid(n - 1, k + 1), 3),
-            (grid(m, k), grid(m, k + 1), 4),
-            (grid(k, m), grid(k + 1, m), 5),
+        // (first vertex, second vertex, skirt edge, quadrants it belongs to)
+        let segments = [
+            (grid(k, 0), grid(k + 1, 0), 0, vec![half(k)]),
+            (grid(k, n - 1), grid(k + 1, n - 1), 1, vec![half(k) | 2]),
+            (grid(0, k), grid(0, k + 1), 2, vec![half(k) << 1]),
+            (
+                grid(n - 1, k),
+                grid(n - 1, k + 1),
+                3,
+                vec![1 | half(k) << 1],
+            ),
+            (
+                grid(m, k),
+                grid(m, k + 1),
+                4,
+                vec![half(k) << 1, 1 | half(k) << 1],
+            ),
+            (grid(k, m), grid(k + 1, m), 5, vec![half(k), half(k) | 2]),
         ];
-        for (a, b, edge) in edges {
+        for (a, b, edge, quadrants) in segments {
             let (sa, sb) = (skirt(edge, k), skirt(edge, k + 1));
-            out.extend_from_slice(&[a, b, sb, a, sb, sa]);
+            for q in quadrants {
+                lists[q as usize].extend_from_slice(&[a, b, sb, a, sb, sa]);
+            }
         }
     }
-    out
+    let mut indices = Vec::new();
+    let quadrants = lists.map(|list| {
+        let start = indices.len() as u32;
+        indices.extend(list);
+        start..indices.len() as u32
+    });
+    PatchMesh { indices, quadrants }
 }
 
 #[cfg(test)]
@@ -44,16 +76,39 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_index_is_a_vertex_and_every_vertex_is_used() {
+    fn quadrants_cover_the_grid_once_and_every_vertex_is_used() {
         let n = 33;
-        let indices = patch_indices(n);
+        let mesh = patch_mesh(n);
         let count = n * n + 6 * n;
-        assert!(indices.iter().all(|&i| i < count));
+        assert!(mesh.indices.iter().all(|&i| i < count));
         let mut used = vec![false; count as usize];
-        for &i in &indices {
+        for &i in &mesh.indices {
             used[i as usize] = true;
         }
         assert!(used.iter().all(|u| *u));
-        assert_eq!(indices.len() as u32, (n - 1) * (n - 1) * 6 + 6 * (n - 1) * 6);
+        // Grid cells once, outer skirts once, midline skirts twice.
+        assert_eq!(
+            mesh.indices.len() as u32,
+            (n - 1) * (n - 1) * 6 + 4 * (n - 1) * 6 + 2 * 2 * (n - 1) * 6
+        );
+        assert_eq!(mesh.quadrants[0].start, 0);
+        assert_eq!(mesh.quadrants[3].end, mesh.indices.len() as u32);
+        // Every grid cell's triangles sit in the quadrant of the cell.
+        for (q, range) in mesh.quadrants.iter().enumerate() {
+            for tri in mesh.indices[range.start as usize..range.end as usize].chunks(3) {
+                if let Some(&v) = tri
+                    .iter()
+                    .find(|&&v| v < n * n && tri.iter().all(|&w| w < n * n))
+                {
+                    let (ci, cj) = (
+                        tri.iter().map(|v| v % n).sum::<u32>(),
+                        tri.iter().map(|v| v / n).sum::<u32>(),
+                    );
+                    let quadrant = ((ci * 2 >= 3 * (n - 1)) as usize)
+                        | (((cj * 2 >= 3 * (n - 1)) as usize) << 1);
+                    assert_eq!(quadrant, q, "triangle with vertex {v}");
+                }
+            }
+        }
     }
 }

@@ -19,16 +19,25 @@ pub struct PatchData {
     pub base_slot: Slot,
     pub river: Option<(Image, Slot)>,
     pub samples: usize,
+    /// Lowest base height (with the border), to know whether the patch can show sea.
+    pub min_height: f32,
     last_used: u64,
 }
 
 impl PatchData {
-    pub fn new(base: Image, base_slot: Slot, river: Option<(Image, Slot)>, samples: usize) -> Self {
+    pub fn new(
+        base: Image,
+        base_slot: Slot,
+        river: Option<(Image, Slot)>,
+        samples: usize,
+        min_height: f32,
+    ) -> Self {
         Self {
             base,
             base_slot,
             river,
             samples,
+            min_height,
             last_used: 0,
         }
     }
