@@ -67,6 +67,24 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Write docs/results.md from the JSON reports of `bench kernel` and `bench flight` (see tools/results).
+    Report {
+        #[arg(long)]
+        kernel: PathBuf,
+        #[arg(long)]
+        kernel_stress: PathBuf,
+        #[arg(long)]
+        flight: PathBuf,
+        #[arg(long)]
+        flight_stress: PathBuf,
+        #[arg(long)]
+        long_flight: Option<PathBuf>,
+        /// A file with the commands that made the reports (quoted in the document).
+        #[arg(long)]
+        commands: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Measure the river kernel variants side by side in one run.
     Bench {
         #[command(subcommand)]
@@ -236,6 +254,28 @@ fn main() -> ExitCode {
                         println!("{}", out.join(n).with_extension("png").display());
                     }
                     ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Report { kernel, kernel_stress, flight, flight_stress, long_flight, commands, out } => {
+            let commands = std::fs::read_to_string(&commands).unwrap_or_default();
+            let inputs = bench::report::ReportInputs {
+                kernel: &kernel,
+                kernel_stress: &kernel_stress,
+                flight: &flight,
+                flight_stress: &flight_stress,
+                long_flight: long_flight.as_deref(),
+                commands: &commands,
+            };
+            match bench::report::results_markdown(&inputs).map(|md| std::fs::write(&out, md)) {
+                Ok(Ok(())) => ExitCode::SUCCESS,
+                Ok(Err(e)) => {
+                    eprintln!("error: cannot write {}: {e}", out.display());
+                    ExitCode::FAILURE
                 }
                 Err(e) => {
                     eprintln!("error: {e}");

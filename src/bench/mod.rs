@@ -7,6 +7,7 @@ pub mod flight;
 pub mod kernel;
 pub mod path;
 pub mod plot;
+pub mod report;
 
 use serde::Serialize;
 
