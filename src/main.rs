@@ -192,6 +192,9 @@ enum BenchCommand {
         stress: bool,
         #[arg(long, default_value_t = 300)]
         frames: u32,
+        /// Camera speed factor (the stress test uses 25).
+        #[arg(long, default_value_t = 1.0)]
+        speed: f64,
         #[arg(long, value_parser = parse_size, default_value = "1280x720")]
         size: [u32; 2],
         /// Skip rerunning each frame's kernel input through all four variants.
@@ -261,7 +264,15 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Report { kernel, kernel_stress, flight, flight_stress, long_flight, commands, out } => {
+        Command::Report {
+            kernel,
+            kernel_stress,
+            flight,
+            flight_stress,
+            long_flight,
+            commands,
+            out,
+        } => {
             let commands = std::fs::read_to_string(&commands).unwrap_or_default();
             let inputs = bench::report::ReportInputs {
                 kernel: &kernel,
@@ -458,6 +469,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             seed,
             stress,
             frames,
+            speed,
             size,
             no_kernel_comparison,
             no_water_comparison,
@@ -474,6 +486,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             let options = bench::flight::FlightOptions {
                 frames,
                 stress,
+                speed,
                 size,
                 compare_kernels: !no_kernel_comparison,
                 compare_water_modes: !no_water_comparison,

@@ -86,7 +86,10 @@ pub struct FlightReport {
 #[derive(Clone, Debug)]
 pub struct FlightOptions {
     pub frames: u32,
+    /// The thesis's stress test: switch factor x10 and camera x25 (overrides `speed`).
     pub stress: bool,
+    /// Camera speed factor.
+    pub speed: f64,
     pub size: [u32; 2],
     /// Run every frame's new river patches through all four kernel variants.
     pub compare_kernels: bool,
@@ -125,7 +128,8 @@ fn fly(
     renderer.water_mode = water;
     renderer.capture_batches = runner.is_some();
     let params = KernelParams::from_config(config);
-    let flight = Flight::new(world, options.frames, options.stress, w as f64 / h as f64);
+    let speed = if options.stress { 25.0 } else { options.speed };
+    let flight = Flight::new(world, options.frames, speed, w as f64 / h as f64);
     let mut frames = Vec::with_capacity(options.frames as usize);
     let mut layout = vk::ImageLayout::UNDEFINED;
     let result = (|| {

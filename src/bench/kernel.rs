@@ -91,7 +91,7 @@ pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Ve
         min: world.planet.stats.min_height as f64 - 1.0,
         max: world.planet.stats.max_height as f64 + config.river.basin_depth as f64 + 1.0,
     };
-    let flight = Flight::new(world, frames, stress, 16.0 / 9.0);
+    let flight = Flight::new(world, frames, if stress { 25.0 } else { 1.0 }, 16.0 / 9.0);
     let mut seen = HashSet::new();
     let mut out = Vec::new();
     for frame in 0..frames {

@@ -24,7 +24,8 @@ const END_ALTITUDE: f64 = 6.0;
 const DESCENT: f64 = 0.6;
 
 impl Flight {
-    pub fn new(world: &World, frames: u32, stress: bool, aspect: f64) -> Self {
+    /// A flight of `frames` frames; `speed` multiplies the camera's speed (25 in the stress test).
+    pub fn new(world: &World, frames: u32, speed: f64, aspect: f64) -> Self {
         let (start, end) = match world.network.systems.first() {
             Some(s) => (s.source, s.mouth),
             None => (DVec3::Z, DVec3::new(0.3, 0.0, 1.0).normalize()),
@@ -34,7 +35,7 @@ impl Flight {
             end,
             radius: world.planet.radius,
             frames: frames.max(1),
-            speed: if stress { 25.0 } else { 1.0 },
+            speed: speed.max(0.01),
             aspect,
         }
     }

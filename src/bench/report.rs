@@ -8,9 +8,14 @@ use serde_json::Value;
 use super::plot::PlotError;
 
 fn read(path: &Path) -> Result<Value, PlotError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| PlotError::Read { path: path.display().to_string(), message: e.to_string() })?;
-    serde_json::from_str(&text).map_err(|e| PlotError::Format { path: path.display().to_string(), message: e.to_string() })
+    let text = std::fs::read_to_string(path).map_err(|e| PlotError::Read {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    serde_json::from_str(&text).map_err(|e| PlotError::Format {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })
 }
 
 fn f(v: &Value) -> f64 {
@@ -52,8 +57,18 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         threads["rayon_threads_used"]
     );
     for (title, thesis, r, table) in [
-        ("Table 9.1: the kernel on the approach", [234.742, 2.136, 1.424, 1.921, 1.174], &k, "9.1"),
-        ("Table 9.2: the kernel in the stress test", [8403.027, 7.372, 5.815, 5.521, 3.963], &ks, "9.2"),
+        (
+            "Table 9.1: the kernel on the approach",
+            [234.742, 2.136, 1.424, 1.921, 1.174],
+            &k,
+            "9.1",
+        ),
+        (
+            "Table 9.2: the kernel in the stress test",
+            [8403.027, 7.372, 5.815, 5.521, 3.963],
+            &ks,
+            "9.2",
+        ),
     ] {
         let v = &r["variants"];
         let _ = writeln!(w, "## {title}\n");
@@ -68,18 +83,41 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             r["relevant_pairs"],
             r["repetitions"]
         );
-        let _ = writeln!(w, "| Table {table} | thesis (i7-4771 / Titan X) | measured here (lavapipe) |");
+        let _ = writeln!(
+            w,
+            "| Table {table} | thesis (i7-4771 / Titan X) | measured here (lavapipe) |"
+        );
         let _ = writeln!(w, "|---|---|---|");
         let rows = [
-            ("CPU (single thread)", thesis[0], f(&v["cpu_single"]["kernel_ms"])),
-            ("CPU (rayon, not in the thesis)", f64::NAN, f(&v["cpu_rayon"]["kernel_ms"])),
+            (
+                "CPU (single thread)",
+                thesis[0],
+                f(&v["cpu_single"]["kernel_ms"]),
+            ),
+            (
+                "CPU (rayon, not in the thesis)",
+                f64::NAN,
+                f(&v["cpu_rayon"]["kernel_ms"]),
+            ),
             ("GPU", thesis[1], f(&v["gpu_simple"]["end_to_end_ms"])),
-            ("GPU kernel call", thesis[2], f(&v["gpu_simple"]["kernel_ms"])),
+            (
+                "GPU kernel call",
+                thesis[2],
+                f(&v["gpu_simple"]["kernel_ms"]),
+            ),
             ("GPU tiled", thesis[3], f(&v["gpu_tiled"]["end_to_end_ms"])),
-            ("GPU tiled kernel call", thesis[4], f(&v["gpu_tiled"]["kernel_ms"])),
+            (
+                "GPU tiled kernel call",
+                thesis[4],
+                f(&v["gpu_tiled"]["kernel_ms"]),
+            ),
         ];
         for (name, t, m) in rows {
-            let thesis = if t.is_nan() { "-".to_string() } else { format!("{t:.3} ms") };
+            let thesis = if t.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{t:.3} ms")
+            };
             let _ = writeln!(w, "| {name} | {thesis} | {m:.3} ms |");
         }
         let ratio = &r["ratios"];
@@ -98,7 +136,10 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             f(&r["relative_diff"]),
         );
     }
-    for (title, r, prefix) in [("The approach", &fl, ""), ("The stress test", &fs, "stress_")] {
+    for (title, r, prefix) in [
+        ("The approach", &fl, ""),
+        ("The stress test", &fs, "stress_"),
+    ] {
         let s = &r["summary"];
         let res = &r["resolution"];
         let _ = writeln!(w, "## Flight: {title}\n");
@@ -156,11 +197,23 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         } else {
             &[
                 ("fig9_6_cpu_vs_gpu", "Fig. 9.6: CPU vs GPU, stress test"),
-                ("fig9_5a_patches", "Fig. 9.5(a): patches per frame, stress test"),
-                ("fig9_5b_samples", "Fig. 9.5(b): samples per frame, stress test"),
-                ("fig9_7_simple_vs_tiled", "Fig. 9.7: simple vs tiled kernel, stress test"),
+                (
+                    "fig9_5a_patches",
+                    "Fig. 9.5(a): patches per frame, stress test",
+                ),
+                (
+                    "fig9_5b_samples",
+                    "Fig. 9.5(b): samples per frame, stress test",
+                ),
+                (
+                    "fig9_7_simple_vs_tiled",
+                    "Fig. 9.7: simple vs tiled kernel, stress test",
+                ),
                 ("fig9_8_memory", "Fig. 9.8: memory per frame, stress test"),
-                ("frame_time_by_water_mode", "Frame time per water mode, stress test"),
+                (
+                    "frame_time_by_water_mode",
+                    "Frame time per water mode, stress test",
+                ),
                 ("gpu_passes", "GPU time per pass, stress test"),
             ]
         };
@@ -173,7 +226,7 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         let s = &l["summary"];
         let _ = writeln!(
             w,
-            "## Memory over a long flight\n\nThe stress flight over {} frames at {}x{}: at most {} resident patches \
+            "## Memory over a long flight\n\nThe flight at 25 times the camera speed over {} frames at {}x{}: at most {} resident patches \
              (budget {}), at most {:.1} MB of patch textures, {:.1} MB in all (with the precomputed heights).\n",
             s["frames"],
             l["resolution"][0],
@@ -184,13 +237,21 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             f(&s["max_memory_bytes"]) / 1e6,
         );
     }
-    let _ = writeln!(w, "## How these numbers were made\n\n```sh\n{}\n```", inputs.commands.trim());
+    let _ = writeln!(
+        w,
+        "## How these numbers were made\n\n```sh\n{}\n```",
+        inputs.commands.trim()
+    );
     Ok(md)
 }
 
 fn map_ms(v: &Value) -> String {
     match v.as_object() {
-        Some(m) => m.iter().map(|(k, x)| format!("{k} {:.3}", f(x))).collect::<Vec<_>>().join(", "),
+        Some(m) => m
+            .iter()
+            .map(|(k, x)| format!("{k} {:.3}", f(x)))
+            .collect::<Vec<_>>()
+            .join(", "),
         None => "-".into(),
     }
 }

@@ -318,9 +318,31 @@ impl<'w> Renderer<'w> {
             .collect();
         wanted.sort_by_key(|p| (p.level, p.face, p.y, p.x));
         wanted.dedup();
+        // Mark what this frame draws from (its own data or a stand-in) so that eviction leaves it, then make room:
+        // the cache never holds more than its budget, so at most that many patches get data.
+        for s in &visible {
+            let source = if self.cache.contains(&s.patch) {
+                Some(s.patch)
+            } else {
+                self.cache.resident_ancestor(s.patch)
+            };
+            if let Some(source) = source {
+                self.cache.touch(&source);
+            }
+        }
         let budget = self.config.rendering.new_patches_per_frame as usize;
-        stats.pending_patches = wanted.len().saturating_sub(budget);
-        missing.extend(wanted.into_iter().take(budget));
+        let wanted_now = (roots + wanted.len().min(budget)).min(self.cache.capacity);
+        stats.evicted_patches =
+            self.cache
+                .evict_to(self.cache.capacity - wanted_now, ctx, &mut self.bindless);
+        let room = self
+            .cache
+            .capacity
+            .saturating_sub(self.cache.len())
+            .saturating_sub(roots);
+        let take = budget.min(room);
+        stats.pending_patches = wanted.len().saturating_sub(take);
+        missing.extend(wanted.into_iter().take(take));
         stats.new_patches = missing.len() - roots;
 
         // Sections 6.3-6.4: base heights and river samples of the new patches, in parallel.
@@ -512,7 +534,6 @@ impl<'w> Renderer<'w> {
             *stats.gpu_ms.entry(scope.name).or_default() += scope.ms;
         }
 
-        stats.evicted_patches = self.cache.evict(ctx, &mut self.bindless);
         stats.resident_patches = self.cache.len();
         stats.patch_texture_bytes = self.cache.bytes();
         stats.precomputed_height_bytes = self.planet.heights.bytes();
@@ -665,7 +686,8 @@ impl<'w> Renderer<'w> {
         if let Some(s) = self.bindless.allocate() {
             return Ok(s);
         }
-        self.cache.evict(self.ctx, &mut self.bindless);
+        let capacity = self.cache.capacity;
+        self.cache.evict_to(capacity, self.ctx, &mut self.bindless);
         self.bindless.allocate().ok_or_else(|| {
             GpuError::Invalid(format!(
                 "all {} bindless slots are in use; raise max-resident-patches or lower new-patches-per-frame",

@@ -125,10 +125,11 @@ impl PatchCache {
         self.entries.values().map(PatchData::bytes).sum()
     }
 
-    /// Evicts least recently used patches (never the roots, never one used this frame) until at most `capacity`
-    /// remain; their textures are freed once the GPU is done with them. Returns how many were evicted.
-    pub fn evict(&mut self, ctx: &Context, bindless: &mut Bindless) -> usize {
-        if self.entries.len() <= self.capacity {
+    /// Evicts least recently used patches (never the roots, never one used this frame) until at most `target`
+    /// remain (or only protected ones); their textures are freed once the GPU is done with them. Returns how many
+    /// were evicted.
+    pub fn evict_to(&mut self, target: usize, ctx: &Context, bindless: &mut Bindless) -> usize {
+        if self.entries.len() <= target {
             return 0;
         }
         let mut candidates: Vec<(u64, PatchId)> = self
@@ -138,7 +139,7 @@ impl PatchCache {
             .map(|(id, e)| (e.last_used, *id))
             .collect();
         candidates.sort();
-        let excess = self.entries.len() - self.capacity;
+        let excess = self.entries.len() - target;
         let mut evicted = 0;
         for (_, id) in candidates.into_iter().take(excess) {
             if let Some(data) = self.entries.remove(&id) {

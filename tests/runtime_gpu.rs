@@ -1,0 +1,163 @@
+//! The run-time algorithm on a device: river data of a patch is the same alone or in a batch and when recomputed
+//! after eviction; the patch cache stays within its budget over a long scripted flight.
+
+mod common;
+
+use std::sync::OnceLock;
+
+use riverplanet::{
+    bench::path::Flight,
+    config::Config,
+    gpu::{bindless::Bindless, vk},
+    kernel::{
+        gpu::{run_batch, KernelTuning, KernelVariant, RiverKernel},
+        KernelParams, PatchJob,
+    },
+    planet::cube::PatchId,
+    render::{
+        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        Renderer,
+    },
+    river::samples::{patch_samples, PatchFrame},
+    world::World,
+};
+
+fn world() -> &'static World {
+    static WORLD: OnceLock<World> = OnceLock::new();
+    WORLD.get_or_init(|| {
+        let mut c = Config::default();
+        c.rendering.max_level_of_detail = 5;
+        World::build(&c, 2).unwrap()
+    })
+}
+
+/// Patches of several levels along the first river, each influenced by it.
+fn river_patches(world: &World) -> Vec<PatchId> {
+    let system = &world.network.systems[0];
+    let (face, u, v) = riverplanet::planet::cube::face_of(system.source);
+    (1..=5u8)
+        .map(|level| {
+            let n = 1u32 << level;
+            let cell = |c: f64| (((c + 1.0) / 2.0 * n as f64) as u32).min(n - 1);
+            PatchId {
+                face: face as u8,
+                level,
+                x: cell(u),
+                y: cell(v),
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn river_data_is_identical_alone_in_a_batch_and_after_recomputing() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = world();
+    let n = world.config.rendering.vertices;
+    let params = KernelParams::from_config(&world.config);
+    let patches = river_patches(world);
+    let samples: Vec<_> = patches
+        .iter()
+        .map(|p| patch_samples(&world.network, &PatchFrame::new(*p, world.planet.radius, n)))
+        .collect();
+    assert!(
+        samples.iter().all(|s| !s.is_empty()),
+        "every chosen patch has river samples"
+    );
+    let jobs: Vec<PatchJob> = patches
+        .iter()
+        .zip(&samples)
+        .map(|(p, s)| PatchJob {
+            spacing: PatchFrame::new(*p, world.planet.radius, n).spacing() as f32,
+            samples: s,
+        })
+        .collect();
+    let mut bindless = Bindless::new(ctx, 64).unwrap();
+    let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx)).unwrap();
+    for variant in [KernelVariant::Simple, KernelVariant::Tiled] {
+        let batch = run_batch(ctx, &mut bindless, &kernel, variant, &jobs, &params).unwrap();
+        for (k, job) in jobs.iter().enumerate() {
+            let alone = run_batch(ctx, &mut bindless, &kernel, variant, &[*job], &params).unwrap();
+            assert_eq!(
+                alone.texels[0], batch.texels[k],
+                "{variant:?}: patch {:?} alone vs in a batch",
+                patches[k]
+            );
+        }
+        // Recomputing from scratch (as after eviction): same samples, same texels, bit for bit.
+        let again: Vec<_> = patches
+            .iter()
+            .map(|p| patch_samples(&world.network, &PatchFrame::new(*p, world.planet.radius, n)))
+            .collect();
+        assert_eq!(again, samples);
+        let reversed: Vec<PatchJob> = jobs.iter().rev().copied().collect();
+        let recomputed =
+            run_batch(ctx, &mut bindless, &kernel, variant, &reversed, &params).unwrap();
+        for (k, texels) in recomputed.texels.iter().rev().enumerate() {
+            assert_eq!(
+                texels, &batch.texels[k],
+                "{variant:?}: recomputed patch {:?} differs",
+                patches[k]
+            );
+        }
+    }
+    kernel.destroy(ctx);
+    ctx.wait_idle().unwrap();
+    bindless.destroy(ctx);
+    common::assert_no_validation_errors(ctx);
+}
+
+#[test]
+fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = world();
+    let mut config = world.config.clone();
+    config.rendering.max_resident_patches = 96;
+    config.rendering.new_patches_per_frame = 16;
+    config.rendering.level_of_detail_switch_factor *= 10.0;
+    let target = Offscreen::new(ctx, 96, 64).unwrap();
+    let mut renderer = Renderer::new(
+        ctx,
+        &world.planet,
+        &world.network,
+        &config,
+        COLOR_FORMAT,
+        DEPTH_FORMAT,
+    )
+    .unwrap();
+    let frames = 200;
+    let flight = Flight::new(world, frames, 25.0, 1.5);
+    let mut layout = vk::ImageLayout::UNDEFINED;
+    let mut evicted = 0;
+    for frame in 0..frames {
+        let stats = renderer
+            .render(
+                &flight.camera(world, frame),
+                &target.target([0.0, 0.0, 0.0, 1.0]),
+                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                &[],
+                &[],
+            )
+            .unwrap();
+        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        evicted += stats.evicted_patches;
+        assert!(
+            stats.resident_patches <= 96,
+            "frame {frame}: {} resident patches exceed the budget of 96",
+            stats.resident_patches
+        );
+        assert!(
+            stats.new_patches <= 16,
+            "frame {frame}: {} new patches exceed the per-frame budget",
+            stats.new_patches
+        );
+    }
+    assert!(
+        evicted > 0,
+        "the flight never filled the cache, so the budget was not tested"
+    );
+    renderer.destroy();
+    target.destroy(ctx);
+    ctx.wait_idle().unwrap();
+    common::assert_no_validation_errors(ctx);
+}
