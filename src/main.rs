@@ -205,6 +205,9 @@ enum BenchCommand {
         no_water_comparison: bool,
         #[arg(long)]
         json: PathBuf,
+        /// Leave the per-frame records out of the JSON (for very long flights).
+        #[arg(long)]
+        summary_only: bool,
         #[arg(long)]
         csv: Option<PathBuf>,
     },
@@ -474,6 +477,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             no_kernel_comparison,
             no_water_comparison,
             json,
+            summary_only,
             csv,
         } => {
             use std::io::IsTerminal;
@@ -536,11 +540,16 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             }
             println!("  frame ms by water mode: {:?}", s.water_mode_frame_ms);
             check_validation(&ctx)?;
-            write_json(&json, &report)?;
             if let Some(path) = csv {
                 std::fs::write(&path, bench::flight::to_csv(&report))
                     .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
             }
+            let mut report = report;
+            if summary_only {
+                report.frames.clear();
+                report.water_mode_frames.clear();
+            }
+            write_json(&json, &report)?;
             Ok(())
         }
     }
