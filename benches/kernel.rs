@@ -25,13 +25,7 @@ fn kernel(c: &mut Criterion) {
             workload::random_patches(lod as u64, 4, n, 64.0 / (1 << lod) as f32, &params)
         })
         .collect();
-    let jobs: Vec<PatchJob> = patches
-        .iter()
-        .map(|(s, v)| PatchJob {
-            spacing: *s,
-            samples: v,
-        })
-        .collect();
+    let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     let mut group = c.benchmark_group("river kernel");
     group.sample_size(10);
     group.bench_function("cpu single thread", |b| {

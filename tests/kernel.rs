@@ -8,7 +8,7 @@ use riverplanet::{
     kernel::{
         cpu,
         gpu::{run_batch, KernelTuning, KernelVariant, RiverKernel},
-        workload, KernelParams, PatchJob, RiverSample, RiverTexel,
+        max_abs_diff, workload, KernelParams, PatchJob, RiverSample, RiverTexel,
     },
 };
 
@@ -138,35 +138,11 @@ fn degenerate_derivative_and_border_vertices_stay_finite() {
 fn rayon_equals_single_threaded() {
     let p = params();
     let patches = workload::random_patches(3, 6, N, 1.0, &p);
-    let jobs: Vec<PatchJob> = patches
-        .iter()
-        .map(|(s, v)| PatchJob {
-            spacing: *s,
-            samples: v,
-        })
-        .collect();
+    let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     assert_eq!(
         cpu::compute_patches(&jobs, N, &p),
         cpu::compute_patches_rayon(&jobs, N, &p)
     );
-}
-
-fn max_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
-    let mut worst = 0.0f32;
-    for (pa, pb) in a.iter().zip(b) {
-        for (x, y) in pa.iter().zip(pb) {
-            for (u, v) in [
-                (x.terrain_height, y.terrain_height),
-                (x.lerp_factor, y.lerp_factor),
-                (x.water_height, y.water_height),
-                (x.min_distance, y.min_distance),
-                (x.river_width, y.river_width),
-            ] {
-                worst = worst.max((u - v).abs());
-            }
-        }
-    }
-    worst
 }
 
 #[test]
@@ -189,13 +165,7 @@ fn gpu_kernels_equal_the_cpu_reference() {
         0.5,
         vec![RiverSample::new([900.0, 900.0], [1.0, 1.0], 2.0, 2.0)],
     ));
-    let jobs: Vec<PatchJob> = patches
-        .iter()
-        .map(|(s, v)| PatchJob {
-            spacing: *s,
-            samples: v,
-        })
-        .collect();
+    let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     let reference = cpu::compute_patches(&jobs, N, &p);
     let range = reference
         .iter()
@@ -216,7 +186,7 @@ fn gpu_kernels_equal_the_cpu_reference() {
         let kernel = RiverKernel::new(ctx, &bindless, N, tuning).unwrap();
         for variant in [KernelVariant::Simple, KernelVariant::Tiled] {
             let gpu = run_batch(ctx, &mut bindless, &kernel, variant, &jobs, &p).unwrap();
-            let diff = max_diff(&reference, &gpu.texels);
+            let diff = max_abs_diff(&reference, &gpu.texels);
             assert!(
                 diff <= tolerance,
                 "{variant:?} {tuning:?}: max difference {diff} > {tolerance}"

@@ -145,14 +145,7 @@ fn fly(
             layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
             let kernels = match (&mut runner, renderer.last_batch.is_empty()) {
                 (Some(runner), false) => {
-                    let jobs: Vec<PatchJob> = renderer
-                        .last_batch
-                        .iter()
-                        .map(|(s, v)| PatchJob {
-                            spacing: *s,
-                            samples: v,
-                        })
-                        .collect();
+                    let jobs = PatchJob::from_pairs(&renderer.last_batch);
                     let (v, _, _) = runner.measure(ctx, &jobs, &params, 1, false)?;
                     Some(FrameKernels {
                         cpu_single_ms: v.cpu_single.kernel_ms,

@@ -12,7 +12,7 @@ use crate::{
     kernel::{
         cpu,
         gpu::{run_batch, KernelTuning, KernelVariant, RiverKernel},
-        KernelParams, PatchJob, RiverSample, RiverTexel,
+        max_abs_diff, KernelParams, PatchJob, RiverSample, RiverTexel,
     },
     river::samples::{patch_samples, PatchFrame},
     runtime::{
@@ -115,24 +115,6 @@ pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Ve
         }
     }
     out
-}
-
-fn max_abs_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
-    a.iter()
-        .flatten()
-        .zip(b.iter().flatten())
-        .map(|(x, y)| {
-            [
-                (x.terrain_height - y.terrain_height).abs(),
-                (x.lerp_factor - y.lerp_factor).abs(),
-                (x.water_height - y.water_height).abs(),
-                (x.min_distance - y.min_distance).abs(),
-                (x.river_width - y.river_width).abs(),
-            ]
-            .into_iter()
-            .fold(0.0f32, f32::max)
-        })
-        .fold(0.0, f32::max)
 }
 
 fn count_relevant_pairs(jobs: &[PatchJob], n: u32, params: &KernelParams) -> u64 {
@@ -249,13 +231,7 @@ pub fn kernel_bench(
     let params = KernelParams::from_config(&world.config);
     let n = world.config.rendering.vertices;
     let patches = flight_workload(world, stress, frames);
-    let jobs: Vec<PatchJob> = patches
-        .iter()
-        .map(|(s, v)| PatchJob {
-            spacing: *s,
-            samples: v,
-        })
-        .collect();
+    let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     let mut runner = VariantRunner::new(ctx, jobs.len(), n, tuning)?;
     let measured = runner.measure(ctx, &jobs, &params, repetitions, true);
     runner.destroy(ctx);

@@ -79,3 +79,35 @@ pub struct PatchJob<'a> {
 pub fn vertex_position(i: u32, j: u32, spacing: f32) -> [f32; 2] {
     [i as f32 * spacing, j as f32 * spacing]
 }
+
+impl<'a> PatchJob<'a> {
+    /// Jobs for (vertex spacing, samples) pairs, as workloads and renderer batches hold them.
+    pub fn from_pairs(pairs: &'a [(f32, Vec<RiverSample>)]) -> Vec<PatchJob<'a>> {
+        pairs
+            .iter()
+            .map(|(spacing, samples)| PatchJob {
+                spacing: *spacing,
+                samples,
+            })
+            .collect()
+    }
+}
+
+/// The largest difference in any of the five outputs between two sets of patches (GPU vs CPU reference).
+pub fn max_abs_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| {
+            [
+                (x.terrain_height - y.terrain_height).abs(),
+                (x.lerp_factor - y.lerp_factor).abs(),
+                (x.water_height - y.water_height).abs(),
+                (x.min_distance - y.min_distance).abs(),
+                (x.river_width - y.river_width).abs(),
+            ]
+            .into_iter()
+            .fold(0.0f32, f32::max)
+        })
+        .fold(0.0, f32::max)
+}
