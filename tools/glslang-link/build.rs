@@ -14,7 +14,8 @@ const LIBS: [&str; 8] = [
 ];
 
 fn main() {
-    let dir = std::env::var("SHADERC_LIB_DIR").unwrap_or_else(|_| "/usr/lib/x86_64-linux-gnu".into());
+    let dir =
+        std::env::var("SHADERC_LIB_DIR").unwrap_or_else(|_| "/usr/lib/x86_64-linux-gnu".into());
     println!("cargo:rerun-if-env-changed=SHADERC_LIB_DIR");
     println!("cargo:rustc-link-search=native={dir}");
     for lib in LIBS {
