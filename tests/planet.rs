@@ -286,3 +286,15 @@ fn base_resolution_must_fit_the_patch_grid() {
         "{err}"
     );
 }
+
+#[test]
+fn tiny_grids_generate_without_panicking() {
+    let mut c = Config::default();
+    c.rendering.vertices = 5;
+    c.rendering.max_level_of_detail = 2;
+    c.planet.base_resolution = 9;
+    let planet = Planet::generate(&c, 1, |_| {}).unwrap();
+    assert!(planet.mountains.is_empty());
+    let network = riverplanet::river::network::RiverNetwork::generate(&planet, &c, 1);
+    assert!(network.systems.is_empty());
+}

@@ -334,6 +334,13 @@ fn seed_mountains(base: &mut FaceLattice, config: &Config, seed: u64) -> Vec<Mou
     let wanted = (p.mountains_per_continent * p.continents.max(1)) as usize;
     let mut rng = Rng::new(seed, &[STREAM_MOUNTAINS]);
     let coarse = config.rendering.vertices - 1;
+    if coarse < 8 {
+        log::warn!(
+            "vertices {} leaves no room for 3x3 mountain masks inside a face; no mountains",
+            coarse + 1
+        );
+        return Vec::new();
+    }
     let k = base.cells / coarse;
     let mut used = vec![false; FACES * (coarse as usize + 1).pow(2)];
     let used_index = |f: usize, x: u32, y: u32| {
