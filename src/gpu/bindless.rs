@@ -129,10 +129,6 @@ impl Bindless {
         self.free.push(slot.0);
     }
 
-    pub fn free_slots(&self) -> usize {
-        self.free.len()
-    }
-
     /// Points `slot` at `image`: as a storage image in GENERAL layout (if `storage`), and as a sampled image in
     /// `sampled_layout`.
     pub fn write(

@@ -20,6 +20,17 @@ pub fn shader_module(
     Ok(module)
 }
 
+/// Map entries for `count` consecutive `u32` specialization constants (constant_id 0, 1, ...).
+fn specialization_entries(count: usize) -> Vec<vk::SpecializationMapEntry> {
+    (0..count as u32)
+        .map(|i| vk::SpecializationMapEntry {
+            constant_id: i,
+            offset: i * 4,
+            size: 4,
+        })
+        .collect()
+}
+
 /// A descriptor set layout of `count` storage buffers at bindings 0..count, for per-dispatch inputs (samples,
 /// range table). Sets are allocated per recording with [`Recorder::buffer_set`].
 pub struct BufferSetLayout {
@@ -89,13 +100,7 @@ impl ComputePipeline {
                 return Err(e);
             }
         };
-        let entries: Vec<_> = (0..specialization.len() as u32)
-            .map(|i| vk::SpecializationMapEntry {
-                constant_id: i,
-                offset: i * 4,
-                size: 4,
-            })
-            .collect();
+        let entries = specialization_entries(specialization.len());
         let spec = vk::SpecializationInfo::default()
             .map_entries(&entries)
             .data(bytemuck::cast_slice(specialization));
@@ -226,13 +231,7 @@ impl GraphicsPipeline {
             let vertex = make(desc.vertex, "vertex")?;
             let geometry = desc.geometry.map(|g| make(g, "geometry")).transpose()?;
             let fragment = make(desc.fragment, "fragment")?;
-            let entries: Vec<_> = (0..desc.specialization.len() as u32)
-                .map(|i| vk::SpecializationMapEntry {
-                    constant_id: i,
-                    offset: i * 4,
-                    size: 4,
-                })
-                .collect();
+            let entries = specialization_entries(desc.specialization.len());
             let spec = vk::SpecializationInfo::default()
                 .map_entries(&entries)
                 .data(bytemuck::cast_slice(desc.specialization));

@@ -24,15 +24,6 @@ pub enum KernelVariant {
     Tiled,
 }
 
-impl KernelVariant {
-    pub fn name(self) -> &'static str {
-        match self {
-            KernelVariant::Simple => "simple",
-            KernelVariant::Tiled => "tiled",
-        }
-    }
-}
-
 /// Workgroup shapes and tile size, chosen by measurement (docs/kernel.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct KernelTuning {
@@ -98,6 +89,14 @@ struct PushParams {
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
 pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
+
+/// One dispatch's input: the fresh river texture of every job (in job order), the range table, the samples.
+#[derive(Clone, Copy)]
+pub struct KernelBatch<'a> {
+    pub textures: &'a [&'a Image],
+    pub jobs: &'a [GpuPatchJob],
+    pub samples: &'a [RiverSample],
+}
 
 /// Both kernel pipelines, ready to record dispatches.
 pub struct RiverKernel {
@@ -175,18 +174,32 @@ impl RiverKernel {
         })
     }
 
-    /// Records one dispatch computing every job into its slot's river texture (which must be in GENERAL layout).
-    /// The sample and range-table buffers are host-visible per-dispatch buffers, freed when the submission
-    /// completes. Returns their size in bytes (the frame's temporary sample memory).
+    /// Records one dispatch computing every job of `batch` into its slot's river texture. The textures are fresh
+    /// (any layout): they are moved to GENERAL here. The sample and range-table buffers are host-visible
+    /// per-dispatch buffers, freed when the submission completes. Returns their size in bytes (the frame's
+    /// temporary sample memory). The caller makes the results visible to whatever reads them next.
     pub fn record(
         &self,
         rec: &mut Recorder,
         bindless: &Bindless,
         variant: KernelVariant,
-        jobs: &[GpuPatchJob],
-        samples: &[RiverSample],
+        batch: &KernelBatch,
         params: &KernelParams,
     ) -> Result<u64, GpuError> {
+        let KernelBatch {
+            textures,
+            jobs,
+            samples,
+        } = *batch;
+        rec.image_transitions(
+            textures,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        );
         if jobs.is_empty() {
             return Ok(0);
         }
@@ -351,17 +364,13 @@ pub fn run_batch(
     let mut profiler = Profiler::new(ctx, 2, "river kernel timestamps")?;
     let image_refs: Vec<&Image> = images.iter().collect();
     let result = ctx.run_and_wait("river kernel batch", |rec| {
-        rec.image_transitions(
-            &image_refs,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
-            vk::PipelineStageFlags2::NONE,
-            vk::AccessFlags2::NONE,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        );
+        let batch = KernelBatch {
+            textures: &image_refs,
+            jobs: &table,
+            samples: &samples,
+        };
         let scope = profiler.begin(rec, "kernel")?;
-        let bytes = kernel.record(rec, bindless, variant, &table, &samples, params)?;
+        let bytes = kernel.record(rec, bindless, variant, &batch, params)?;
         profiler.end(rec, scope);
         rec.memory_barrier(
             vk::PipelineStageFlags2::COMPUTE_SHADER,

@@ -18,7 +18,10 @@ use crate::{
         Recorder,
     },
     kernel::{
-        gpu::{create_river_texture, GpuPatchJob, KernelTuning, KernelVariant, RiverKernel},
+        gpu::{
+            create_river_texture, GpuPatchJob, KernelBatch, KernelTuning, KernelVariant,
+            RiverKernel,
+        },
         KernelParams, RiverSample,
     },
     planet::{cube::PatchId, Planet},
@@ -633,25 +636,16 @@ impl<'w> Renderer<'w> {
         }
         let mut bytes = 0;
         if !rivers.is_empty() {
-            let refs: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
-            rec.image_transitions(
-                &refs,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::GENERAL,
-                vk::PipelineStageFlags2::NONE,
-                vk::AccessFlags2::NONE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            );
+            let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
+            let batch = KernelBatch {
+                textures: &textures,
+                jobs: &jobs,
+                samples: &samples,
+            };
             let scope = self.profiler.begin(rec, "kernel")?;
-            bytes = self.kernel.record(
-                rec,
-                &self.bindless,
-                self.variant,
-                &jobs,
-                &samples,
-                &self.params,
-            )?;
+            bytes = self
+                .kernel
+                .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
             self.profiler.end(rec, scope);
             rec.memory_barrier(
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
@@ -694,10 +688,6 @@ impl<'w> Renderer<'w> {
                 self.bindless.capacity
             ))
         })
-    }
-
-    pub fn resident_patches(&self) -> usize {
-        self.cache.len()
     }
 
     /// Frees every GPU object of the renderer (after the device is idle).

@@ -91,10 +91,6 @@ impl PatchCache {
         })
     }
 
-    pub fn get(&self, patch: &PatchId) -> Option<&PatchData> {
-        self.entries.get(patch)
-    }
-
     pub fn insert(&mut self, patch: PatchId, mut data: PatchData) {
         data.last_used = self.frame;
         self.entries.insert(patch, data);
