@@ -15,7 +15,10 @@ const STAGES: [(&str, shaderc::ShaderKind); 4] = [
 extern crate glslang_link;
 
 fn main() {
-    let glsl_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+    // Read at run time, not with env!(): a build-script binary cached by another checkout must not compile that
+    // checkout's shaders.
+    let manifest_dir = env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
+    let glsl_dir = Path::new(&manifest_dir).join("glsl");
     let out_dir = env::var("OUT_DIR").expect("cargo sets OUT_DIR");
     println!("cargo:rerun-if-changed={}", glsl_dir.display());
 
