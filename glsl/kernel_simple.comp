@@ -12,7 +12,7 @@ void main() {
     vec2 v = vec2(xy) * job.spacing;
     Accumulators acc = initAccumulators();
     for (uint k = 0; k < job.sampleCount; ++k) {
-        accumulateSample(acc, v, samples[job.sampleOffset + k]);
+        accumulateSample(acc, v, prepareSample(samples[job.sampleOffset + k]));
     }
     storeHeight(acc, job, xy);
 }

@@ -2,77 +2,100 @@
 // Tiled GPU version (7.3.2): the workgroup stages a tile of samples in shared memory, waits at a barrier, and
 // every invocation reads the tile from there; a barrier guards the next tile's load.
 //
-// Beyond the thesis (docs/kernel.md): a workgroup is a square block of the patch's vertices (x, y from the
-// workgroup id; z selects the patch), and staging keeps only the samples within reach of the block's bounding
-// box, compacted in their original order. Every invocation then loops over the in-reach samples only, with a
-// trip count that is uniform across the group. Order is preserved, so the sums equal the simple kernel's.
-layout(local_size_x_id = 0, local_size_y_id = 1) in;
-layout(constant_id = 2) const uint TILE_SIZE = 256;
-// Invocations per workgroup (x * y of the block), for the size of the offsets array.
-layout(constant_id = 3) const uint GROUP_SIZE = 32;
+// Beyond the thesis (docs/kernel.md):
+// - a workgroup is a block of the patch's vertices (x, y from the workgroup id; z selects the patch), its
+//   invocations laid out in Morton order, so that every subgroup covers a compact square of vertices;
+// - staging copies only the samples that the reach masks of kernel_reach.comp mark for this block, compacted in
+//   their original order (a subgroup scan of the mask words' bit counts gives each word its place);
+// - every invocation loops over the staged samples only, with a trip count uniform across the group. Each
+//   lane of a subgroup reads a different staged sample and the subgroup shares them by broadcast: one
+//   shared-memory read per sample and subgroup instead of one per invocation.
+// The order of summation is the sample order, so the sums equal the simple kernel's.
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+// Invocations per workgroup: BLOCK_X x BLOCK_Y, a multiple of the subgroup size (full subgroups are required).
+layout(local_size_x_id = 0) in;
+// The vertex block: powers of two, square or twice as wide as high (for the Morton layout).
+layout(constant_id = 1) const uint BLOCK_X = 8;
+layout(constant_id = 2) const uint BLOCK_Y = 8;
+// Samples per tile: a multiple of 32 (one mask word covers 32 samples), at most 32 x the invocations.
+layout(constant_id = 3) const uint TILE_SIZE = 1024;
 #include "river_kernel.glsl"
+#include "kernel_blocks.glsl"
 
-// The staged samples as arrays of vec4 and vec2 (24 bytes a sample; faster than an array of structs on
-// lavapipe, and 1024 of them fit 32 KiB of shared memory).
+// The staged samples, prepared (prepareSample), as arrays of vec4, vec2 and float: 28 bytes a sample, faster
+// than an array of structs on lavapipe, and 1024 of them fit 32 KiB of shared memory.
 shared vec4 tilePositionDerivative[TILE_SIZE];
-shared vec2 tileHeightWidth[TILE_SIZE];
-// Per invocation: how many samples of its chunk are in reach, then the exclusive prefix sum of those counts.
-shared uint chunkOffset[GROUP_SIZE];
-shared uint tileCount;
+shared vec2 tileHeightHalfWidth[TILE_SIZE];
+shared float tileInverseScale[TILE_SIZE];
+// In-reach samples of the tile counted by each subgroup (at most one subgroup per invocation).
+shared uint subgroupCounts[BLOCK_X * BLOCK_Y];
+
+// The even bits of `i`, packed: one coordinate of a Morton index.
+uint evenBits(uint i) {
+    i &= 0x55555555u;
+    i = (i | (i >> 1)) & 0x33333333u;
+    i = (i | (i >> 2)) & 0x0f0f0f0fu;
+    i = (i | (i >> 4)) & 0x00ff00ffu;
+    return (i | (i >> 8)) & 0x0000ffffu;
+}
+
+// The vertex of the block that invocation `i` computes: Morton order within BLOCK_Y x BLOCK_Y squares, squares
+// side by side along x.
+uvec2 vertexInBlock(uint i) {
+    uint square = BLOCK_Y * BLOCK_Y;
+    uint j = i % square;
+    return uvec2(evenBits(j) + (i / square) * BLOCK_Y, evenBits(j >> 1));
+}
 
 void main() {
     PatchJob job = jobs[gl_WorkGroupID.z];
-    uint n = params.gridSize;
-    uvec2 first = gl_WorkGroupID.xy * gl_WorkGroupSize.xy;
-    uvec2 last = min(first + gl_WorkGroupSize.xy, uvec2(n)) - 1;
-    uvec2 xy = first + gl_LocalInvocationID.xy;
-    // Invocations beyond the grid still stage samples and reach every barrier.
-    bool hasVertex = xy.x < n && xy.y < n;
-    vec2 v = vec2(xy) * job.spacing;
-    vec2 boxMin = vec2(first) * job.spacing;
-    vec2 boxMax = vec2(last) * job.spacing;
-    float reach = params.influenceDistance * 1.0001 + 1e-4;
+    uvec2 size = uvec2(BLOCK_X, BLOCK_Y);
+    uvec2 count = blockCount(size);
+    uint blocks = count.x * count.y;
+    uint block = gl_WorkGroupID.y * count.x + gl_WorkGroupID.x;
     uint lane = gl_LocalInvocationIndex;
-    uint groupSize = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
-    // Each invocation stages a contiguous chunk of at most 32 samples of a tile (a bit mask remembers which).
-    uint chunk = (TILE_SIZE + groupSize - 1) / groupSize;
+    uvec2 xy = gl_WorkGroupID.xy * size + vertexInBlock(lane);
+    // Invocations beyond the grid take part in staging and in the subgroup broadcasts, and store nothing.
+    bool hasVertex = xy.x < params.gridSize && xy.y < params.gridSize;
+    vec2 v = vec2(xy) * job.spacing;
+    uint tileWords = TILE_SIZE / 32;
 
     Accumulators acc = initAccumulators();
     for (uint base = 0; base < job.sampleCount; base += TILE_SIZE) {
-        uint count = min(TILE_SIZE, job.sampleCount - base);
-        uint begin = min(lane * chunk, count);
-        uint end = min(begin + chunk, count);
-        uint inReach = 0;
-        for (uint k = begin; k < end; ++k) {
-            vec2 p = samples[job.sampleOffset + base + k].positionDerivative.xy;
-            if (length(p - clamp(p, boxMin, boxMax)) <= reach) inReach |= 1u << (k - begin);
-        }
-        chunkOffset[lane] = bitCount(inReach);
+        // Invocation w holds mask word w of the tile; its samples go to `at` onwards.
+        uint word = base / 32 + lane;
+        uint bits = lane < tileWords && word < wordsOf(job) ? reachMasks[reachMaskIndex(job, blocks, block, word)] : 0;
+        uint at = subgroupExclusiveAdd(bitCount(bits));
+        if (gl_SubgroupInvocationID == gl_SubgroupSize - 1) subgroupCounts[gl_SubgroupID] = at + bitCount(bits);
         barrier();
-        if (lane == 0) {
-            uint sum = 0;
-            for (uint i = 0; i < groupSize; ++i) {
-                uint c = chunkOffset[i];
-                chunkOffset[i] = sum;
-                sum += c;
-            }
-            tileCount = sum;
+        uint staged = 0;
+        for (uint i = 0; i < gl_NumSubgroups; ++i) {
+            uint c = subgroupCounts[i];
+            at += i < gl_SubgroupID ? c : 0;
+            staged += c;
         }
-        barrier();
-        uint at = chunkOffset[lane];
-        for (uint k = begin; k < end; ++k) {
-            if ((inReach & (1u << (k - begin))) != 0) {
-                RiverSample s = samples[job.sampleOffset + base + k];
-                tilePositionDerivative[at] = s.positionDerivative;
-                tileHeightWidth[at] = s.heightWidth.xy;
-                ++at;
-            }
+        while (bits != 0) {
+            uint k = word * 32 + uint(findLSB(bits));
+            bits &= bits - 1;
+            PreparedSample s = prepareSample(samples[job.sampleOffset + k]);
+            tilePositionDerivative[at] = s.positionDerivative;
+            tileHeightHalfWidth[at] = vec2(s.height, s.halfWidth);
+            tileInverseScale[at] = s.inverseScale;
+            ++at;
         }
         barrier();
-        uint staged = tileCount;
-        if (hasVertex) {
-            for (uint k = 0; k < staged; ++k) {
-                accumulateSample(acc, v, RiverSample(tilePositionDerivative[k], vec4(tileHeightWidth[k], 0.0, 0.0)));
+        for (uint first = 0; first < staged; first += gl_SubgroupSize) {
+            uint mine = min(first + gl_SubgroupInvocationID, staged - 1);
+            vec4 positionDerivative = tilePositionDerivative[mine];
+            vec2 heightHalfWidth = tileHeightHalfWidth[mine];
+            float inverseScale = tileInverseScale[mine];
+            uint sharing = min(gl_SubgroupSize, staged - first);
+            for (uint from = 0; from < sharing; ++from) {
+                PreparedSample s = PreparedSample(subgroupBroadcast(positionDerivative, from),
+                    subgroupBroadcast(heightHalfWidth.x, from), subgroupBroadcast(heightHalfWidth.y, from),
+                    subgroupBroadcast(inverseScale, from));
+                accumulateSample(acc, v, s);
             }
         }
         barrier();

@@ -8,12 +8,14 @@ struct RiverSample {
     vec4 heightWidth;
 };
 
-// One patch of the dispatch: its grid spacing, its range of samples, its bindless slot.
+// One patch of the dispatch: its grid spacing, its range of samples, its bindless slot, and where its reach
+// masks start (in units of words x blocks; used by the tiled kernel only, see kernel_blocks.glsl).
 struct PatchJob {
     float spacing;
     uint sampleOffset;
     uint sampleCount;
     uint slot;
+    uint maskOffset;
 };
 
 // Layer 0: terrain height, lerp factor, water height, signed minimum distance. Layer 1: river half width.
@@ -45,37 +47,56 @@ Accumulators initAccumulators() {
     return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38);
 }
 
-// Procedure 3 for one sample, accumulated as in Procedure 4. On SIMD hardware the body runs under a mask for the
-// whole subgroup when any lane is in reach; lavapipe runs it under a mask always (measured: 0.7 ms for the
-// distance tests of a workload alone, 43 ms with the masked body), which is why the tiled kernel culls samples
-// per workgroup with a workgroup-uniform test.
-void accumulateSample(inout Accumulators acc, vec2 v, RiverSample s) {
+// A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
+// stages it, the simple kernel on every read.
+struct PreparedSample {
+    vec4 positionDerivative;
+    float height;
+    float halfWidth;
+    // 1 / (halfWidth x |derivative|): turns the unnormalised distances along and across the flow into the
+    // fractions of the half width that Procedure 3 uses. 1 / halfWidth for a zero derivative.
+    float inverseScale;
+};
+
+PreparedSample prepareSample(RiverSample s) {
+    vec2 d = s.positionDerivative.zw;
+    float halfWidth = s.heightWidth.y * 0.5;
+    float speed = d == vec2(0.0) ? 1.0 : length(d);
+    return PreparedSample(s.positionDerivative, s.heightWidth.x, halfWidth, 1.0 / (halfWidth * speed));
+}
+
+// Procedure 3 for one sample, accumulated as in Procedure 4.
+//
+// The same quantities as the CPU reference, computed with one square root instead of three and no division
+// (docs/kernel.md): with r = v - p, the projection distance |vn - v| is |r.d| / |d| and the normal distance
+// |p - vn| is |d x r| / |d|, and d x r is the side of the line Procedure 3 takes the sign from. For a zero
+// derivative the normal line degenerates to p, so the projection distance is the distance to p.
+//
+// On SIMD hardware the body runs under a mask for the whole subgroup when any lane is in reach; lavapipe runs it
+// under a mask always, which is why the tiled kernel stages only the samples within reach of its vertex block.
+void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
     vec2 p = s.positionDerivative.xy;
     vec2 d = s.positionDerivative.zw;
-    float dist = length(v - p);
+    vec2 r = v - p;
+    float dist = length(r);
     if (dist <= params.influenceDistance) {
-        float halfWidth = s.heightWidth.y * 0.5;
-        vec2 n = vec2(d.y, -d.x);
-        float nn = n.x * n.x + n.y * n.y;
-        float t = nn > 0.0 ? ((v.x - p.x) * n.x + (v.y - p.y) * n.y) / nn : 0.0;
-        vec2 vn = p + t * n;
-        float projectionDistance = length(vn - v);
-        float normalDistance = length(p - vn);
-        float wDist = 1.0 - dist / params.influenceDistance;
+        float along = d == vec2(0.0) ? dist : abs(r.x * d.x + r.y * d.y);
+        float side = d.x * r.y - d.y * r.x;
+        float wDist = 1.0 - dist * (1.0 / params.influenceDistance);
         float basinDepth = wDist * params.basinDepth;
-        acc.heightSum += wDist * s.heightWidth.x;
+        acc.heightSum += wDist * s.height;
         acc.weightSum += wDist;
         acc.basinSum += basinDepth;
-        acc.widthSum += wDist * halfWidth;
-        if (projectionDistance < halfWidth && normalDistance <= halfWidth) {
-            float normalFactor = normalDistance / halfWidth;
+        acc.widthSum += wDist * s.halfWidth;
+        // projectionDistance < halfWidth and normalDistance <= halfWidth, as fractions of the half width.
+        float wRiver = 1.0 - along * s.inverseScale;
+        float normalFactor = abs(side) * s.inverseScale;
+        if (wRiver > 0.0 && normalFactor <= 1.0) {
             float factor = normalFactor * normalFactor * normalFactor;
-            float wRiver = 1.0 - projectionDistance / halfWidth;
             acc.inRiver = true;
             acc.inRiverSum += wRiver * factor * basinDepth;
             acc.inRiverWSum += wRiver;
         }
-        float side = d.x * (v.y - p.y) - d.y * (v.x - p.x);
         float signedDist = side > 0.0 ? -dist : dist;
         if (abs(signedDist) < abs(acc.minDistance)) acc.minDistance = signedDist;
     }
@@ -101,6 +122,6 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
                         acc.minDistance);
         }
     }
-    imageStore(riverImages[nonuniformEXT(job.slot)], ivec3(xy, 0), heights);
-    imageStore(riverImages[nonuniformEXT(job.slot)], ivec3(xy, 1), vec4(riverWidth, 0.0, 0.0, 0.0));
+    imageStore(riverImages[job.slot], ivec3(xy, 0), heights);
+    imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, 0.0, 0.0, 0.0));
 }

@@ -161,6 +161,11 @@ fn gpu_kernels_equal_the_cpu_reference() {
         vec![RiverSample::new([8.0, 4.0], [1.0, 0.0], 2.0, 2.0)],
     ));
     patches.push((2.0, vec![]));
+    // A sample with a zero derivative (the normal line degenerates to the sample point).
+    patches.push((
+        1.0,
+        vec![RiverSample::new([10.0, 10.0], [0.0, 0.0], 3.0, 4.0)],
+    ));
     patches.push((
         0.5,
         vec![RiverSample::new([900.0, 900.0], [1.0, 1.0], 2.0, 2.0)],
@@ -179,7 +184,7 @@ fn gpu_kernels_equal_the_cpu_reference() {
         KernelTuning::default(),
         KernelTuning {
             simple_workgroup: 128,
-            tiled_block: [16, 4],
+            tiled_block: [8, 4],
             tile_size: 32,
         },
     ] {

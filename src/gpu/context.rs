@@ -80,6 +80,7 @@ pub struct Context {
     pub(crate) deletion: DeletionQueue,
     pub(crate) timeline: Timeline,
     pub properties: vk::PhysicalDeviceProperties,
+    pub subgroup: features::SubgroupProperties,
     pub timestamp_valid_bits: u32,
     validation_log: Box<ValidationLog>,
     validation_enabled: bool,
@@ -386,6 +387,7 @@ impl Context {
         // SAFETY: family index 0 of the family we created.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let properties = unsafe { instance.get_physical_device_properties(physical) };
+        let subgroup = features::subgroup_properties(&instance, physical);
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let timestamp_valid_bits = families[queue_family as usize].timestamp_valid_bits;
 
@@ -423,6 +425,7 @@ impl Context {
             deletion: DeletionQueue::default(),
             timeline,
             properties,
+            subgroup,
             timestamp_valid_bits,
             validation_log,
             validation_enabled,

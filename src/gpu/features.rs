@@ -49,6 +49,10 @@ pub fn query(
     let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
     let family = queue_family.and_then(|i| families.get(i as usize));
     let api_ok = props.api_version >= vk::API_VERSION_1_3;
+    let subgroup = subgroup_properties(instance, physical);
+    let subgroup_ops = vk::SubgroupFeatureFlags::BASIC
+        | vk::SubgroupFeatureFlags::BALLOT
+        | vk::SubgroupFeatureFlags::ARITHMETIC;
 
     let b = |x: vk::Bool32| x == vk::TRUE;
     let checks = vec![
@@ -100,6 +104,17 @@ pub fn query(
             b(v13.maintenance4),
         ),
         (
+            "subgroup basic, ballot and arithmetic operations in compute shaders",
+            subgroup
+                .supported_stages
+                .contains(vk::ShaderStageFlags::COMPUTE)
+                && subgroup.supported_operations.contains(subgroup_ops),
+        ),
+        (
+            "subgroupSizeControl and computeFullSubgroups",
+            b(v13.subgroup_size_control) && b(v13.compute_full_subgroups),
+        ),
+        (
             "timestamps on the queue",
             family.is_some_and(|f| f.timestamp_valid_bits > 0)
                 && props.limits.timestamp_period > 0.0,
@@ -143,7 +158,40 @@ impl EnabledFeatures {
             v13: vk::PhysicalDeviceVulkan13Features::default()
                 .synchronization2(true)
                 .dynamic_rendering(true)
-                .maintenance4(true),
+                .maintenance4(true)
+                .subgroup_size_control(true)
+                .compute_full_subgroups(true),
         }
+    }
+}
+
+/// What the device's subgroups can do, and their sizes (the tiled river kernel shares samples across a subgroup).
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct SubgroupProperties {
+    #[serde(skip)]
+    pub supported_stages: vk::ShaderStageFlags,
+    #[serde(skip)]
+    pub supported_operations: vk::SubgroupFeatureFlags,
+    pub min_size: u32,
+    pub max_size: u32,
+}
+
+/// Queries the subgroup properties of `physical`.
+pub fn subgroup_properties(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+) -> SubgroupProperties {
+    let mut v11 = vk::PhysicalDeviceVulkan11Properties::default();
+    let mut v13 = vk::PhysicalDeviceVulkan13Properties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default()
+        .push_next(&mut v11)
+        .push_next(&mut v13);
+    // SAFETY: plain query with a chain on this stack frame.
+    unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
+    SubgroupProperties {
+        supported_stages: v11.subgroup_supported_stages,
+        supported_operations: v11.subgroup_supported_operations,
+        min_size: v13.min_subgroup_size,
+        max_size: v13.max_subgroup_size,
     }
 }

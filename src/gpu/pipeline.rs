@@ -80,6 +80,34 @@ impl ComputePipeline {
         push_constant_bytes: u32,
         specialization: &[u32],
     ) -> Result<Self, GpuError> {
+        let flags = vk::PipelineShaderStageCreateFlags::empty();
+        let layout = (set_layouts, push_constant_bytes);
+        Self::with_stage_flags(ctx, spirv, name, layout, specialization, flags)
+    }
+
+    /// As [`ComputePipeline::new`], for a shader whose subgroups must all be full (Vulkan 1.3
+    /// computeFullSubgroups; the workgroup size must be a multiple of the device's largest subgroup size).
+    pub fn with_full_subgroups(
+        ctx: &Context,
+        spirv: &[u8],
+        name: &str,
+        set_layouts: &[vk::DescriptorSetLayout],
+        push_constant_bytes: u32,
+        specialization: &[u32],
+    ) -> Result<Self, GpuError> {
+        let flags = vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS;
+        let layout = (set_layouts, push_constant_bytes);
+        Self::with_stage_flags(ctx, spirv, name, layout, specialization, flags)
+    }
+
+    fn with_stage_flags(
+        ctx: &Context,
+        spirv: &[u8],
+        name: &str,
+        (set_layouts, push_constant_bytes): (&[vk::DescriptorSetLayout], u32),
+        specialization: &[u32],
+        flags: vk::PipelineShaderStageCreateFlags,
+    ) -> Result<Self, GpuError> {
         let module = shader_module(ctx, spirv, name)?;
         let ranges = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::COMPUTE)
@@ -105,6 +133,7 @@ impl ComputePipeline {
             .map_entries(&entries)
             .data(bytemuck::cast_slice(specialization));
         let stage = vk::PipelineShaderStageCreateInfo::default()
+            .flags(flags)
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main")

@@ -302,6 +302,16 @@ impl<'a> Recorder<'a> {
         );
     }
 
+    /// Fills all of `buffer` with the `u32` `value` (for buffers the GPU accumulates into, e.g. with atomics).
+    pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
+        // SAFETY: recording; the buffer outlives the submission and has TRANSFER_DST usage (validated).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
+        };
+    }
+
     pub fn buffer_barrier(
         &mut self,
         buffer: &Buffer,

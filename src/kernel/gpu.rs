@@ -47,25 +47,75 @@ impl Default for KernelTuning {
 }
 
 impl KernelTuning {
-    /// The default, with the tile shrunk to what the device's shared memory holds (32 KiB devices get 512).
+    /// The default, with the block grown until it holds whole subgroups of the device's largest size, and the
+    /// tile shrunk to what the device's shared memory holds.
     pub fn for_device(ctx: &Context) -> Self {
         let mut t = Self::default();
+        while t.tiled_invocations() < ctx.subgroup.max_size {
+            let [x, y] = t.tiled_block;
+            t.tiled_block = if x > y { [x, y * 2] } else { [x * 2, y] };
+        }
         let shared = ctx.properties.limits.max_compute_shared_memory_size;
-        while t.tile_size > 32
-            && tiled_shared_bytes(t.tile_size, t.tiled_block[0] * t.tiled_block[1]) > shared
-        {
+        while t.tile_size > 32 && tiled_shared_bytes(t.tile_size, t.tiled_invocations()) > shared {
             t.tile_size /= 2;
         }
         t
     }
+
+    /// Invocations per workgroup of the tiled kernel: one per vertex of the block.
+    pub fn tiled_invocations(&self) -> u32 {
+        self.tiled_block[0] * self.tiled_block[1]
+    }
+
+    /// Checks the tuning against the kernels' layout rules and the device's limits; the message names the value
+    /// and its valid range.
+    pub fn validate(&self, ctx: &Context) -> Result<(), String> {
+        let limit = ctx.properties.limits.max_compute_work_group_invocations;
+        let subgroup = ctx.subgroup.max_size.max(1);
+        let [x, y] = self.tiled_block;
+        let invocations = self.tiled_invocations();
+        if self.simple_workgroup == 0 || self.simple_workgroup > limit {
+            return Err(format!(
+                "simple workgroup of {} invocations must be in [1, {limit}]",
+                self.simple_workgroup
+            ));
+        }
+        if !x.is_power_of_two() || !y.is_power_of_two() || !(x == y || x == 2 * y) {
+            return Err(format!(
+                "tiled block {x}x{y} must be powers of two, square or twice as wide as high (Morton layout)"
+            ));
+        }
+        if invocations > limit || invocations % subgroup != 0 {
+            return Err(format!(
+                "tiled block {x}x{y} has {invocations} invocations; it must be a multiple of the largest \
+                 subgroup size {subgroup} and at most {limit}"
+            ));
+        }
+        if self.tile_size == 0 || self.tile_size % 32 != 0 || self.tile_size > 32 * invocations {
+            return Err(format!(
+                "tile size {} must be a positive multiple of 32 (one reach-mask word) and at most 32 x the \
+                 block's {invocations} invocations",
+                self.tile_size
+            ));
+        }
+        let shared = ctx.properties.limits.max_compute_shared_memory_size;
+        let needed = tiled_shared_bytes(self.tile_size, invocations);
+        if needed > shared {
+            return Err(format!(
+                "tile size {} needs {needed} bytes of shared memory; the device has {shared}",
+                self.tile_size
+            ));
+        }
+        Ok(())
+    }
 }
 
-/// Shared memory of the tiled kernel: the staged samples (24 bytes each), the per-invocation offsets and a count.
-pub fn tiled_shared_bytes(tile_size: u32, group_size: u32) -> u32 {
-    tile_size * 24 + group_size * 4 + 4
+/// Shared memory of the tiled kernel: the staged samples (28 bytes each) and one count per possible subgroup.
+pub fn tiled_shared_bytes(tile_size: u32, invocations: u32) -> u32 {
+    tile_size * 28 + invocations * 4
 }
 
-/// One row of the range table (std430, 16 bytes).
+/// One row of the range table (std430, 20 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuPatchJob {
@@ -73,6 +123,16 @@ pub struct GpuPatchJob {
     pub sample_offset: u32,
     pub sample_count: u32,
     pub slot: u32,
+    /// Mask words (one bit per sample) of the jobs before this one; the tiled kernel's reach masks of this
+    /// patch start at `mask_offset` x blocks per patch.
+    pub mask_offset: u32,
+}
+
+impl GpuPatchJob {
+    /// Reach-mask words per vertex block of this patch: one bit per sample.
+    pub fn mask_words(&self) -> u32 {
+        self.sample_count.div_ceil(32)
+    }
 }
 
 #[repr(C)]
@@ -84,6 +144,9 @@ struct PushParams {
     basin_water_offset: f32,
     grid_size: u32,
 }
+
+/// Invocations per workgroup of the reach pre-pass (`local_size_x` of kernel_reach.comp).
+const REACH_WORKGROUP: u32 = 64;
 
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
@@ -101,8 +164,12 @@ pub struct KernelBatch<'a> {
 /// Both kernel pipelines, ready to record dispatches.
 pub struct RiverKernel {
     simple: ComputePipeline,
+    /// The tiled kernel's pre-pass: which samples reach which vertex block (kernel_reach.comp).
+    reach: ComputePipeline,
     tiled: ComputePipeline,
+    /// Samples and range table (simple); plus the reach masks (reach pre-pass and tiled).
     inputs: BufferSetLayout,
+    tiled_inputs: BufferSetLayout,
     pub grid_size: u32,
     pub tuning: KernelTuning,
 }
@@ -114,36 +181,11 @@ impl RiverKernel {
         grid_size: u32,
         tuning: KernelTuning,
     ) -> Result<Self, GpuError> {
-        let limit = ctx.properties.limits.max_compute_work_group_invocations;
-        let block = tuning.tiled_block[0] * tuning.tiled_block[1];
-        for (what, size) in [
-            ("simple workgroup", tuning.simple_workgroup),
-            ("tiled block", block),
-        ] {
-            if size == 0 || size > limit {
-                return Err(GpuError::Invalid(format!(
-                    "{what} of {size} invocations must be in [1, {limit}]"
-                )));
-            }
-        }
-        let shared = ctx.properties.limits.max_compute_shared_memory_size;
-        let needed = tiled_shared_bytes(tuning.tile_size, block);
-        if needed > shared {
-            return Err(GpuError::Invalid(format!(
-                "tile size {} needs {needed} bytes of shared memory; the device has {shared} (use --tile-size {} or less)",
-                tuning.tile_size,
-                (shared.saturating_sub(tiled_shared_bytes(0, block)) / 24).next_power_of_two() / 2
-            )));
-        }
-        // The tiled kernel stages at most 32 samples per invocation (a bit mask) and 1024 invocations.
-        if tuning.tile_size == 0 || tuning.tile_size > 32 * block || block > 1024 {
-            return Err(GpuError::Invalid(format!(
-                "tile size {} must be in [1, 32 x block size {block}], block size at most 1024",
-                tuning.tile_size
-            )));
-        }
+        tuning.validate(ctx).map_err(GpuError::Invalid)?;
         let inputs = BufferSetLayout::new(ctx, 2, "river kernel inputs")?;
+        let tiled_inputs = BufferSetLayout::new(ctx, 3, "tiled river kernel inputs")?;
         let layouts = [bindless.layout, inputs.layout];
+        let tiled_layouts = [bindless.layout, tiled_inputs.layout];
         let push = std::mem::size_of::<PushParams>() as u32;
         let simple = ComputePipeline::new(
             ctx,
@@ -153,13 +195,22 @@ impl RiverKernel {
             push,
             &[tuning.simple_workgroup],
         )?;
-        let tiled = ComputePipeline::new(
+        let reach = ComputePipeline::new(
+            ctx,
+            shaders::KERNEL_REACH_COMP,
+            "river kernel reach masks",
+            &tiled_layouts,
+            push,
+            &tuning.tiled_block,
+        )?;
+        let tiled = ComputePipeline::with_full_subgroups(
             ctx,
             shaders::KERNEL_TILED_COMP,
             "river kernel tiled",
-            &layouts,
+            &tiled_layouts,
             push,
             &[
+                tuning.tiled_invocations(),
                 tuning.tiled_block[0],
                 tuning.tiled_block[1],
                 tuning.tile_size,
@@ -167,8 +218,10 @@ impl RiverKernel {
         )?;
         Ok(Self {
             simple,
+            reach,
             tiled,
             inputs,
+            tiled_inputs,
             grid_size,
             tuning,
         })
@@ -216,8 +269,7 @@ impl RiverKernel {
         };
         let sample_buffer = host_buffer("river samples", bytemuck::cast_slice(samples))?;
         let job_buffer = host_buffer("river range table", bytemuck::cast_slice(jobs))?;
-        let bytes = sample_buffer.size + job_buffer.size;
-        let set = rec.buffer_set(&self.inputs, &[&sample_buffer, &job_buffer])?;
+        let mut bytes = sample_buffer.size + job_buffer.size;
         let push = PushParams {
             influence_distance: params.influence_distance,
             basin_depth: params.basin_depth,
@@ -225,24 +277,52 @@ impl RiverKernel {
             basin_water_offset: params.basin_water_offset,
             grid_size: self.grid_size,
         };
+        let push = bytemuck::bytes_of(&push);
         let n = self.grid_size;
         let patches = jobs.len() as u32;
-        let (pipeline, groups) = match variant {
-            KernelVariant::Simple => (
-                &self.simple,
-                [(n * n).div_ceil(self.tuning.simple_workgroup), patches, 1],
-            ),
+        match variant {
+            KernelVariant::Simple => {
+                let set = rec.buffer_set(&self.inputs, &[&sample_buffer, &job_buffer])?;
+                let groups = [(n * n).div_ceil(self.tuning.simple_workgroup), patches, 1];
+                rec.dispatch(&self.simple, &[bindless.set, set], push, groups);
+            }
             KernelVariant::Tiled => {
                 let [bx, by] = self.tuning.tiled_block;
-                (&self.tiled, [n.div_ceil(bx), n.div_ceil(by), patches])
+                let blocks = [n.div_ceil(bx), n.div_ceil(by)];
+                let words: u64 = jobs.iter().map(|j| j.mask_words() as u64).sum();
+                let masks = ctx.create_buffer(&BufferDesc {
+                    name: "river reach masks",
+                    size: (words * (blocks[0] * blocks[1]) as u64 * 4).max(16),
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                })?;
+                bytes += masks.size;
+                let set =
+                    rec.buffer_set(&self.tiled_inputs, &[&sample_buffer, &job_buffer, &masks])?;
+                rec.fill_buffer(&masks, 0);
+                rec.buffer_barrier(
+                    &masks,
+                    vk::PipelineStageFlags2::CLEAR,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                );
+                let most_samples = jobs.iter().map(|j| j.sample_count).max().unwrap_or(0);
+                let reach_groups = [most_samples.div_ceil(REACH_WORKGROUP).max(1), patches, 1];
+                rec.dispatch(&self.reach, &[bindless.set, set], push, reach_groups);
+                rec.buffer_barrier(
+                    &masks,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ,
+                );
+                let groups = [blocks[0], blocks[1], patches];
+                rec.dispatch(&self.tiled, &[bindless.set, set], push, groups);
+                rec.free_after_completion(masks);
             }
-        };
-        rec.dispatch(
-            pipeline,
-            &[bindless.set, set],
-            bytemuck::bytes_of(&push),
-            groups,
-        );
+        }
         rec.free_after_completion(sample_buffer);
         rec.free_after_completion(job_buffer);
         Ok(bytes)
@@ -250,8 +330,10 @@ impl RiverKernel {
 
     pub fn destroy(self, ctx: &Context) {
         self.simple.destroy(ctx);
+        self.reach.destroy(ctx);
         self.tiled.destroy(ctx);
         self.inputs.destroy(ctx);
+        self.tiled_inputs.destroy(ctx);
     }
 }
 
@@ -276,6 +358,7 @@ pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result
 /// Flattens per-patch jobs into one sample array and a range table, with patch k written to `slots[k]`.
 pub fn pack_jobs(jobs: &[PatchJob], slots: &[Slot]) -> (Vec<GpuPatchJob>, Vec<RiverSample>) {
     let mut samples = Vec::with_capacity(jobs.iter().map(|j| j.samples.len()).sum());
+    let mut mask_offset = 0;
     let table = jobs
         .iter()
         .zip(slots)
@@ -285,7 +368,9 @@ pub fn pack_jobs(jobs: &[PatchJob], slots: &[Slot]) -> (Vec<GpuPatchJob>, Vec<Ri
                 sample_offset: samples.len() as u32,
                 sample_count: job.samples.len() as u32,
                 slot: slot.0,
+                mask_offset,
             };
+            mask_offset += row.mask_words();
             samples.extend_from_slice(job.samples);
             row
         })

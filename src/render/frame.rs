@@ -19,10 +19,9 @@ use crate::{
     },
     kernel::{
         gpu::{
-            create_river_texture, GpuPatchJob, KernelBatch, KernelTuning, KernelVariant,
-            RiverKernel,
+            create_river_texture, pack_jobs, KernelBatch, KernelTuning, KernelVariant, RiverKernel,
         },
-        KernelParams, RiverSample,
+        KernelParams, PatchJob, RiverSample,
     },
     planet::{cube::PatchId, Planet},
     river::{
@@ -612,8 +611,7 @@ impl<'w> Renderer<'w> {
         );
 
         let mut rivers: Vec<(Image, Slot)> = Vec::new();
-        let mut jobs: Vec<GpuPatchJob> = Vec::new();
-        let mut samples: Vec<RiverSample> = Vec::new();
+        let mut patch_jobs: Vec<PatchJob> = Vec::new();
         let mut river_of: Vec<Option<usize>> = Vec::with_capacity(prepared.len());
         for (p, _, patch_samples) in prepared {
             if patch_samples.is_empty() {
@@ -624,16 +622,15 @@ impl<'w> Renderer<'w> {
             let image = create_river_texture(ctx, n, &format!("river data {p:?}"))?;
             self.bindless
                 .write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
-            jobs.push(GpuPatchJob {
+            patch_jobs.push(PatchJob {
                 spacing: PatchFrame::new(*p, self.planet.radius, n).spacing() as f32,
-                sample_offset: samples.len() as u32,
-                sample_count: patch_samples.len() as u32,
-                slot: slot.0,
+                samples: patch_samples,
             });
-            samples.extend_from_slice(patch_samples);
             river_of.push(Some(rivers.len()));
             rivers.push((image, slot));
         }
+        let slots: Vec<Slot> = rivers.iter().map(|(_, s)| *s).collect();
+        let (jobs, samples) = pack_jobs(&patch_jobs, &slots);
         let mut bytes = 0;
         if !rivers.is_empty() {
             let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
