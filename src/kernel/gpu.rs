@@ -145,9 +145,6 @@ struct PushParams {
     grid_size: u32,
 }
 
-/// Invocations per workgroup of the reach pre-pass (`local_size_x` of kernel_reach.comp).
-const REACH_WORKGROUP: u32 = 64;
-
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
 pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -308,9 +305,7 @@ impl RiverKernel {
                     vk::PipelineStageFlags2::COMPUTE_SHADER,
                     vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
                 );
-                let most_samples = jobs.iter().map(|j| j.sample_count).max().unwrap_or(0);
-                let reach_groups = [most_samples.div_ceil(REACH_WORKGROUP).max(1), patches, 1];
-                rec.dispatch(&self.reach, &[bindless.set, set], push, reach_groups);
+                rec.dispatch(&self.reach, &[bindless.set, set], push, [1, patches, 1]);
                 rec.buffer_barrier(
                     &masks,
                     vk::PipelineStageFlags2::COMPUTE_SHADER,
