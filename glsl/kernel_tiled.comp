@@ -28,8 +28,10 @@ layout(constant_id = 3) const uint TILE_SIZE = 1024;
 shared vec4 tilePositionDerivative[TILE_SIZE];
 shared vec2 tileHeightHalfWidth[TILE_SIZE];
 shared float tileInverseScale[TILE_SIZE];
-// In-reach samples of the tile counted by each subgroup (at most one subgroup per invocation).
-shared uint subgroupCounts[BLOCK_X * BLOCK_Y];
+// In-reach samples of a chunk counted by each subgroup (at most one subgroup per invocation), in two rows.
+const uint MAX_SUBGROUPS = BLOCK_X * BLOCK_Y;
+const uint TILE_WORDS = TILE_SIZE / 32;
+shared uint subgroupCounts[2 * MAX_SUBGROUPS];
 
 // The even bits of `i`, packed: one coordinate of a Morton index.
 uint evenBits(uint i) {
@@ -48,6 +50,24 @@ uvec2 vertexInBlock(uint i) {
     return uvec2(evenBits(j) + (i / square) * BLOCK_Y, evenBits(j >> 1));
 }
 
+// Procedure 4 over the first `staged` samples of the tile. Each lane of a subgroup reads one staged sample and
+// the subgroup shares them by broadcast.
+void accumulateTile(inout Accumulators acc, vec2 v, uint staged) {
+    for (uint first = 0; first < staged; first += gl_SubgroupSize) {
+        uint mine = min(first + gl_SubgroupInvocationID, staged - 1);
+        vec4 positionDerivative = tilePositionDerivative[mine];
+        vec2 heightHalfWidth = tileHeightHalfWidth[mine];
+        float inverseScale = tileInverseScale[mine];
+        uint sharing = min(gl_SubgroupSize, staged - first);
+        for (uint from = 0; from < sharing; ++from) {
+            PreparedSample s = PreparedSample(subgroupBroadcast(positionDerivative, from),
+                subgroupBroadcast(heightHalfWidth.x, from), subgroupBroadcast(heightHalfWidth.y, from),
+                subgroupBroadcast(inverseScale, from));
+            accumulateSample(acc, v, s);
+        }
+    }
+}
+
 void main() {
     PatchJob job = jobs[gl_WorkGroupID.z];
     uvec2 size = uvec2(BLOCK_X, BLOCK_Y);
@@ -59,22 +79,35 @@ void main() {
     // Invocations beyond the grid take part in staging and in the subgroup broadcasts, and store nothing.
     bool hasVertex = xy.x < params.gridSize && xy.y < params.gridSize;
     vec2 v = vec2(xy) * job.spacing;
-    uint tileWords = TILE_SIZE / 32;
+    uint words = wordsOf(job);
 
+    // The patch's mask words are read in chunks of TILE_WORDS (invocation i holds word i of the chunk); the
+    // in-reach samples of each chunk are appended to the tile, which is consumed whenever the next chunk might
+    // not fit and at the end. A block within reach of few samples thus stages them all in one tile, however
+    // many samples its patch has.
     Accumulators acc = initAccumulators();
-    for (uint base = 0; base < job.sampleCount; base += TILE_SIZE) {
-        // Invocation w holds mask word w of the tile; its samples go to `at` onwards.
-        uint word = base / 32 + lane;
-        uint bits = lane < tileWords && word < wordsOf(job) ? reachMasks[reachMaskIndex(job, blocks, block, word)] : 0;
+    uint filled = 0;
+    for (uint chunk = 0; chunk * TILE_WORDS < words; ++chunk) {
+        uint word = chunk * TILE_WORDS + lane;
+        uint bits = lane < TILE_WORDS && word < words ? reachMasks[reachMaskIndex(job, blocks, block, word)] : 0;
         uint at = subgroupExclusiveAdd(bitCount(bits));
-        if (gl_SubgroupInvocationID == gl_SubgroupSize - 1) subgroupCounts[gl_SubgroupID] = at + bitCount(bits);
+        // Counts alternate between two rows, so a chunk's counts are never overwritten before every invocation
+        // has read them (the next chunk's barrier comes first).
+        uint row = (chunk % 2) * MAX_SUBGROUPS;
+        if (gl_SubgroupInvocationID == gl_SubgroupSize - 1) subgroupCounts[row + gl_SubgroupID] = at + bitCount(bits);
         barrier();
-        uint staged = 0;
+        uint found = 0;
         for (uint i = 0; i < gl_NumSubgroups; ++i) {
-            uint c = subgroupCounts[i];
+            uint c = subgroupCounts[row + i];
             at += i < gl_SubgroupID ? c : 0;
-            staged += c;
+            found += c;
         }
+        if (filled + found > TILE_SIZE) {
+            accumulateTile(acc, v, filled);
+            barrier();
+            filled = 0;
+        }
+        at += filled;
         while (bits != 0) {
             uint k = word * 32 + uint(findLSB(bits));
             bits &= bits - 1;
@@ -84,21 +117,11 @@ void main() {
             tileInverseScale[at] = s.inverseScale;
             ++at;
         }
-        barrier();
-        for (uint first = 0; first < staged; first += gl_SubgroupSize) {
-            uint mine = min(first + gl_SubgroupInvocationID, staged - 1);
-            vec4 positionDerivative = tilePositionDerivative[mine];
-            vec2 heightHalfWidth = tileHeightHalfWidth[mine];
-            float inverseScale = tileInverseScale[mine];
-            uint sharing = min(gl_SubgroupSize, staged - first);
-            for (uint from = 0; from < sharing; ++from) {
-                PreparedSample s = PreparedSample(subgroupBroadcast(positionDerivative, from),
-                    subgroupBroadcast(heightHalfWidth.x, from), subgroupBroadcast(heightHalfWidth.y, from),
-                    subgroupBroadcast(inverseScale, from));
-                accumulateSample(acc, v, s);
-            }
-        }
-        barrier();
+        filled += found;
     }
+    // The staging of the last chunks is ordered before the body by this barrier; earlier staging by the next
+    // chunk's barrier, which comes before any flush.
+    barrier();
+    accumulateTile(acc, v, filled);
     if (hasVertex) storeHeight(acc, job, xy);
 }

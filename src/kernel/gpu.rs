@@ -110,9 +110,9 @@ impl KernelTuning {
     }
 }
 
-/// Shared memory of the tiled kernel: the staged samples (28 bytes each) and one count per possible subgroup.
+/// Shared memory of the tiled kernel: the staged samples (28 bytes each) and two counts per possible subgroup.
 pub fn tiled_shared_bytes(tile_size: u32, invocations: u32) -> u32 {
-    tile_size * 28 + invocations * 4
+    tile_size * 28 + 2 * invocations * 4
 }
 
 /// One row of the range table (std430, 20 bytes).
