@@ -20,6 +20,9 @@ layout(constant_id = 1) const uint BLOCK_X = 8;
 layout(constant_id = 2) const uint BLOCK_Y = 8;
 // Samples per tile: a multiple of 32 (one mask word covers 32 samples), at most 32 x the invocations.
 layout(constant_id = 3) const uint TILE_SIZE = 1024;
+// The subgroup size the pipeline requires (gl_SubgroupSize): a constant lets the broadcast loop be unrolled,
+// which on lavapipe turns every broadcast into a register shuffle.
+layout(constant_id = 4) const uint SUBGROUP_SIZE = 8;
 #include "river_kernel.glsl"
 #include "kernel_blocks.glsl"
 
@@ -53,13 +56,14 @@ uvec2 vertexInBlock(uint i) {
 // Procedure 4 over the first `staged` samples of the tile. Each lane of a subgroup reads one staged sample and
 // the subgroup shares them by broadcast.
 void accumulateTile(inout Accumulators acc, vec2 v, uint staged) {
-    for (uint first = 0; first < staged; first += gl_SubgroupSize) {
+    for (uint first = 0; first < staged; first += SUBGROUP_SIZE) {
         uint mine = min(first + gl_SubgroupInvocationID, staged - 1);
         vec4 positionDerivative = tilePositionDerivative[mine];
         vec2 heightHalfWidth = tileHeightHalfWidth[mine];
         float inverseScale = tileInverseScale[mine];
-        uint sharing = min(gl_SubgroupSize, staged - first);
-        for (uint from = 0; from < sharing; ++from) {
+        uint sharing = min(SUBGROUP_SIZE, staged - first);
+        for (uint from = 0; from < SUBGROUP_SIZE; ++from) {
+            if (from >= sharing) break;
             PreparedSample s = PreparedSample(subgroupBroadcast(positionDerivative, from),
                 subgroupBroadcast(heightHalfWidth.x, from), subgroupBroadcast(heightHalfWidth.y, from),
                 subgroupBroadcast(inverseScale, from));

@@ -111,8 +111,12 @@ pub fn query(
                 && subgroup.supported_operations.contains(subgroup_ops),
         ),
         (
-            "subgroupSizeControl and computeFullSubgroups",
-            b(v13.subgroup_size_control) && b(v13.compute_full_subgroups),
+            "subgroupSizeControl, computeFullSubgroups and a required subgroup size in compute",
+            b(v13.subgroup_size_control)
+                && b(v13.compute_full_subgroups)
+                && subgroup
+                    .required_size_stages
+                    .contains(vk::ShaderStageFlags::COMPUTE),
         ),
         (
             "timestamps on the queue",
@@ -172,6 +176,8 @@ pub struct SubgroupProperties {
     pub supported_stages: vk::ShaderStageFlags,
     #[serde(skip)]
     pub supported_operations: vk::SubgroupFeatureFlags,
+    #[serde(skip)]
+    pub required_size_stages: vk::ShaderStageFlags,
     pub min_size: u32,
     pub max_size: u32,
 }
@@ -191,6 +197,7 @@ pub fn subgroup_properties(
     SubgroupProperties {
         supported_stages: v11.subgroup_supported_stages,
         supported_operations: v11.subgroup_supported_operations,
+        required_size_stages: v13.required_subgroup_size_stages,
         min_size: v13.min_subgroup_size,
         max_size: v13.max_subgroup_size,
     }

@@ -80,13 +80,13 @@ impl ComputePipeline {
         push_constant_bytes: u32,
         specialization: &[u32],
     ) -> Result<Self, GpuError> {
-        let flags = vk::PipelineShaderStageCreateFlags::empty();
         let layout = (set_layouts, push_constant_bytes);
-        Self::with_stage_flags(ctx, spirv, name, layout, specialization, flags)
+        Self::with_subgroups(ctx, spirv, name, layout, specialization, None)
     }
 
-    /// As [`ComputePipeline::new`], for a shader whose subgroups must all be full (Vulkan 1.3
-    /// computeFullSubgroups; the workgroup size must be a multiple of the device's largest subgroup size).
+    /// As [`ComputePipeline::new`], for a shader that relies on full subgroups of exactly `subgroup_size`
+    /// invocations (Vulkan 1.3 computeFullSubgroups and a required subgroup size; the workgroup size must be a
+    /// multiple of it).
     pub fn with_full_subgroups(
         ctx: &Context,
         spirv: &[u8],
@@ -94,19 +94,26 @@ impl ComputePipeline {
         set_layouts: &[vk::DescriptorSetLayout],
         push_constant_bytes: u32,
         specialization: &[u32],
+        subgroup_size: u32,
     ) -> Result<Self, GpuError> {
-        let flags = vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS;
         let layout = (set_layouts, push_constant_bytes);
-        Self::with_stage_flags(ctx, spirv, name, layout, specialization, flags)
+        Self::with_subgroups(
+            ctx,
+            spirv,
+            name,
+            layout,
+            specialization,
+            Some(subgroup_size),
+        )
     }
 
-    fn with_stage_flags(
+    fn with_subgroups(
         ctx: &Context,
         spirv: &[u8],
         name: &str,
         (set_layouts, push_constant_bytes): (&[vk::DescriptorSetLayout], u32),
         specialization: &[u32],
-        flags: vk::PipelineShaderStageCreateFlags,
+        subgroup_size: Option<u32>,
     ) -> Result<Self, GpuError> {
         let module = shader_module(ctx, spirv, name)?;
         let ranges = [vk::PushConstantRange::default()
@@ -132,12 +139,18 @@ impl ComputePipeline {
         let spec = vk::SpecializationInfo::default()
             .map_entries(&entries)
             .data(bytemuck::cast_slice(specialization));
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .flags(flags)
+        let mut required = vk::PipelineShaderStageRequiredSubgroupSizeCreateInfo::default()
+            .required_subgroup_size(subgroup_size.unwrap_or(0));
+        let mut stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main")
             .specialization_info(&spec);
+        if subgroup_size.is_some() {
+            stage = stage
+                .flags(vk::PipelineShaderStageCreateFlags::REQUIRE_FULL_SUBGROUPS)
+                .push_next(&mut required);
+        }
         let info = [vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(layout)];

@@ -211,7 +211,9 @@ impl RiverKernel {
                 tuning.tiled_block[0],
                 tuning.tiled_block[1],
                 tuning.tile_size,
+                ctx.subgroup.max_size,
             ],
+            ctx.subgroup.max_size,
         )?;
         Ok(Self {
             simple,
