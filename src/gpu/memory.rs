@@ -46,19 +46,23 @@ impl Buffer {
     /// Writes `data` at `offset` into a host-visible buffer; errors if the buffer is not mapped or too small.
     pub fn write<T: bytemuck::Pod>(&mut self, offset: usize, data: &[T]) -> Result<(), GpuError> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
-        let name = self.name.clone();
-        let dst = self
-            .mapped_mut()
-            .ok_or_else(|| GpuError::Invalid(format!("buffer '{name}' is not host-visible")))?;
         let end = offset + bytes.len();
-        if end > dst.len() {
+        let Some(len) = self.mapped().map(<[u8]>::len) else {
+            let name = &self.name;
             return Err(GpuError::Invalid(format!(
-                "write of {} bytes at {offset} overflows buffer '{name}' of {} bytes",
+                "buffer '{name}' is not host-visible"
+            )));
+        };
+        if end > len {
+            return Err(GpuError::Invalid(format!(
+                "write of {} bytes at {offset} overflows buffer '{}' of {len} bytes",
                 bytes.len(),
-                dst.len()
+                self.name
             )));
         }
-        dst[offset..end].copy_from_slice(bytes);
+        if let Some(dst) = self.mapped_mut() {
+            dst[offset..end].copy_from_slice(bytes);
+        }
         Ok(())
     }
 }

@@ -9,8 +9,8 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, ComputePipeline},
-        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler,
-        Recorder, ScopeTiming,
+        vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler, Recorder,
+        ScopeTiming,
     },
     shaders,
 };
@@ -150,12 +150,13 @@ struct PushParams {
 pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 
-/// One dispatch's input: the fresh river texture of every job (in job order), the range table, the samples.
+/// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
+/// spacing and samples.
 #[derive(Clone, Copy)]
 pub struct KernelBatch<'a> {
     pub textures: &'a [&'a Image],
-    pub jobs: &'a [GpuPatchJob],
-    pub samples: &'a [RiverSample],
+    pub slots: &'a [Slot],
+    pub jobs: &'a [PatchJob<'a>],
 }
 
 /// Both kernel pipelines, ready to record dispatches.
@@ -240,8 +241,8 @@ impl RiverKernel {
     ) -> Result<u64, GpuError> {
         let KernelBatch {
             textures,
+            slots,
             jobs,
-            samples,
         } = *batch;
         rec.image_transitions(
             textures,
@@ -256,18 +257,25 @@ impl RiverKernel {
             return Ok(0);
         }
         let ctx = rec.ctx();
-        let host_buffer = |name: &str, bytes: &[u8]| -> Result<Buffer, GpuError> {
-            let mut buffer = ctx.create_buffer(&BufferDesc {
+        let host_buffer = |name: &str, size: usize| {
+            ctx.create_buffer(&BufferDesc {
                 name,
-                size: bytes.len().max(16) as u64,
+                size: size.max(16) as u64,
                 usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                 location: MemoryLocation::CpuToGpu,
-            })?;
-            buffer.write(0, bytes)?;
-            Ok(buffer)
+            })
         };
-        let sample_buffer = host_buffer("river samples", bytemuck::cast_slice(samples))?;
-        let job_buffer = host_buffer("river range table", bytemuck::cast_slice(jobs))?;
+        let table = range_table(jobs, slots);
+        let mut job_buffer = host_buffer("river range table", std::mem::size_of_val(&table[..]))?;
+        job_buffer.write(0, &table)?;
+        // Every patch's samples are written straight into the mapped buffer at its range.
+        let sample_bytes = std::mem::size_of::<RiverSample>();
+        let total: usize = jobs.iter().map(|j| j.samples.len()).sum();
+        let mut sample_buffer = host_buffer("river samples", total * sample_bytes)?;
+        for (job, row) in jobs.iter().zip(&table) {
+            sample_buffer.write(row.sample_offset as usize * sample_bytes, job.samples)?;
+        }
+        let jobs = &table[..];
         let mut bytes = sample_buffer.size + job_buffer.size;
         let push = PushParams {
             influence_distance: params.influence_distance,
@@ -352,44 +360,43 @@ pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result
     })
 }
 
-/// Flattens per-patch jobs into one sample array and a range table, with patch k written to `slots[k]`.
-pub fn pack_jobs(jobs: &[PatchJob], slots: &[Slot]) -> (Vec<GpuPatchJob>, Vec<RiverSample>) {
-    let mut samples = Vec::with_capacity(jobs.iter().map(|j| j.samples.len()).sum());
-    let mut mask_offset = 0;
-    let table = jobs
-        .iter()
+/// The range table of a batch: patch k's samples follow those of the patches before it in one sample buffer,
+/// and its results go to `slots[k]`.
+pub fn range_table(jobs: &[PatchJob], slots: &[Slot]) -> Vec<GpuPatchJob> {
+    let (mut sample_offset, mut mask_offset) = (0, 0);
+    jobs.iter()
         .zip(slots)
         .map(|(job, slot)| {
             let row = GpuPatchJob {
                 spacing: job.spacing,
-                sample_offset: samples.len() as u32,
+                sample_offset,
                 sample_count: job.samples.len() as u32,
                 slot: slot.0,
                 mask_offset,
             };
+            sample_offset += row.sample_count;
             mask_offset += row.mask_words();
-            samples.extend_from_slice(job.samples);
             row
         })
-        .collect();
-    (table, samples)
+        .collect()
 }
 
 /// Decodes one read-back river texture (both layers, tightly packed RGBA32F) into texels.
 pub fn decode_texels(bytes: &[u8], grid_size: u32) -> Vec<RiverTexel> {
-    let floats: &[f32] = bytemuck::cast_slice(bytes);
-    let layer = (grid_size * grid_size) as usize;
-    (0..layer)
-        .map(|k| {
-            let m = &floats[4 * k..4 * k + 4];
-            RiverTexel {
-                terrain_height: m[0],
-                lerp_factor: m[1],
-                water_height: m[2],
-                min_distance: m[3],
-                river_width: floats[4 * (layer + k)],
-            }
-        })
+    let texels: &[[f32; 4]] = bytemuck::cast_slice(bytes);
+    let (heights, widths) = texels.split_at((grid_size * grid_size) as usize);
+    heights
+        .iter()
+        .zip(widths)
+        .map(
+            |(&[terrain_height, lerp_factor, water_height, min_distance], width)| RiverTexel {
+                terrain_height,
+                lerp_factor,
+                water_height,
+                min_distance,
+                river_width: width[0],
+            },
+        )
         .collect()
 }
 
@@ -442,14 +449,13 @@ pub fn run_batch(
         usage: vk::BufferUsageFlags::TRANSFER_DST,
         location: MemoryLocation::GpuToCpu,
     })?;
-    let (table, samples) = pack_jobs(jobs, &slots);
     let mut profiler = Profiler::new(ctx, 2, "river kernel timestamps")?;
     let image_refs: Vec<&Image> = images.iter().collect();
     let result = ctx.run_and_wait("river kernel batch", |rec| {
         let batch = KernelBatch {
             textures: &image_refs,
-            jobs: &table,
-            samples: &samples,
+            slots: &slots,
+            jobs,
         };
         let scope = profiler.begin(rec, "kernel")?;
         let bytes = kernel.record(rec, bindless, variant, &batch, params)?;

@@ -18,9 +18,7 @@ use crate::{
         Recorder,
     },
     kernel::{
-        gpu::{
-            create_river_texture, pack_jobs, KernelBatch, KernelTuning, KernelVariant, RiverKernel,
-        },
+        gpu::{create_river_texture, KernelBatch, KernelTuning, KernelVariant, RiverKernel},
         KernelParams, PatchJob, RiverSample,
     },
     planet::{cube::PatchId, Planet},
@@ -630,14 +628,13 @@ impl<'w> Renderer<'w> {
             rivers.push((image, slot));
         }
         let slots: Vec<Slot> = rivers.iter().map(|(_, s)| *s).collect();
-        let (jobs, samples) = pack_jobs(&patch_jobs, &slots);
         let mut bytes = 0;
         if !rivers.is_empty() {
             let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
             let batch = KernelBatch {
                 textures: &textures,
-                jobs: &jobs,
-                samples: &samples,
+                slots: &slots,
+                jobs: &patch_jobs,
             };
             let scope = self.profiler.begin(rec, "kernel")?;
             bytes = self
