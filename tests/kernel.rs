@@ -202,7 +202,10 @@ fn gpu_kernels_equal_the_cpu_reference() {
             outputs.push(gpu.texels);
         }
         // Same kernel body, same summation order: the tiled kernel equals the simple one bit for bit.
-        assert_eq!(outputs[0], outputs[1], "{tuning:?}: simple and tiled differ");
+        assert_eq!(
+            outputs[0], outputs[1],
+            "{tuning:?}: simple and tiled differ"
+        );
         kernel.destroy(ctx);
     }
     ctx.wait_idle().unwrap();

@@ -11,7 +11,7 @@ use crate::{
     gpu::{bindless::Bindless, Context, GpuError},
     kernel::{
         cpu,
-        gpu::{run_batch, KernelTuning, KernelVariant, RiverKernel},
+        gpu::{run_batch_into, BatchOutputs, KernelTuning, KernelVariant, RiverKernel},
         max_abs_diff, KernelParams, PatchJob, RiverSample, RiverTexel,
     },
     river::samples::{patch_samples, PatchFrame},
@@ -133,10 +133,11 @@ fn count_relevant_pairs(jobs: &[PatchJob], n: u32, params: &KernelParams) -> u64
         .sum()
 }
 
-/// Runs the four variants on the same jobs; keeps its GPU pipelines between measurements.
+/// Runs the four variants on the same jobs; keeps its GPU pipelines and output textures between measurements.
 pub struct VariantRunner {
     bindless: Bindless,
     kernel: RiverKernel,
+    outputs: BatchOutputs,
 }
 
 impl VariantRunner {
@@ -147,9 +148,14 @@ impl VariantRunner {
         n: u32,
         tuning: KernelTuning,
     ) -> Result<Self, GpuError> {
-        let bindless = Bindless::new(ctx, capacity as u32 + 16)?;
+        let mut bindless = Bindless::new(ctx, capacity as u32 + 16)?;
         let kernel = RiverKernel::new(ctx, &bindless, n, tuning)?;
-        Ok(Self { bindless, kernel })
+        let outputs = BatchOutputs::new(ctx, &mut bindless, capacity, n)?;
+        Ok(Self {
+            bindless,
+            kernel,
+            outputs,
+        })
     }
 
     /// Times CPU single-thread, CPU rayon, GPU simple and GPU tiled; `repetitions` runs each (after one warm-up
@@ -178,14 +184,17 @@ impl VariantRunner {
             .collect();
         let mut max_diff = 0.0f32;
         let mut gpu = |variant| -> Result<VariantTiming, GpuError> {
+            let run = || {
+                let (bindless, outputs) = (&self.bindless, &self.outputs);
+                run_batch_into(ctx, bindless, &self.kernel, variant, jobs, params, outputs)
+            };
             if warm_up {
-                run_batch(ctx, &mut self.bindless, &self.kernel, variant, jobs, params)?;
+                run()?;
             }
             let (mut kernel_ms, mut end_to_end) = (Vec::new(), Vec::new());
             for _ in 0..repetitions {
                 let t = Instant::now();
-                let result =
-                    run_batch(ctx, &mut self.bindless, &self.kernel, variant, jobs, params)?;
+                let result = run()?;
                 end_to_end.push(t.elapsed().as_secs_f64() * 1e3);
                 kernel_ms.push(result.timings.iter().map(|s| s.ms).sum());
                 max_diff = max_diff.max(max_abs_diff(&reference, &result.texels));
@@ -215,7 +224,9 @@ impl VariantRunner {
     pub fn destroy(self, ctx: &Context) {
         self.kernel.destroy(ctx);
         let _ = ctx.wait_idle();
-        self.bindless.destroy(ctx);
+        let mut bindless = self.bindless;
+        self.outputs.destroy(ctx, &mut bindless);
+        bindless.destroy(ctx);
     }
 }
 

@@ -9,8 +9,8 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, ComputePipeline},
-        vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler, Recorder,
-        ScopeTiming,
+        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler,
+        Recorder, ScopeTiming,
     },
     shaders,
 };
@@ -407,8 +407,77 @@ pub struct BatchResult {
     pub temporary_bytes: u64,
 }
 
+/// The output side of a batch: a river texture per patch, each in its bindless slot, and a host-visible buffer
+/// the textures are copied to. Benchmarks keep one between repetitions, as the renderer keeps its textures
+/// resident, so that repetitions measure the work and not the driver's first touch of fresh memory.
+pub struct BatchOutputs {
+    images: Vec<Image>,
+    slots: Vec<Slot>,
+    readback: Buffer,
+    grid_size: u32,
+}
+
+impl BatchOutputs {
+    /// Textures and read-back space for up to `patches` patches of `grid_size` x `grid_size` vertices.
+    pub fn new(
+        ctx: &Context,
+        bindless: &mut Bindless,
+        patches: usize,
+        grid_size: u32,
+    ) -> Result<Self, GpuError> {
+        let readback = ctx.create_buffer(&BufferDesc {
+            name: "river readback",
+            size: Self::texel_bytes(grid_size) * patches.max(1) as u64,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        let mut outputs = Self {
+            images: Vec::with_capacity(patches),
+            slots: Vec::with_capacity(patches),
+            readback,
+            grid_size,
+        };
+        for k in 0..patches {
+            let Some(slot) = bindless.allocate() else {
+                let capacity = bindless.capacity;
+                outputs.destroy(ctx, bindless);
+                return Err(GpuError::Invalid(format!(
+                    "batch of {patches} patches exceeds the {capacity} bindless slots"
+                )));
+            };
+            outputs.slots.push(slot);
+            let image = match create_river_texture(ctx, grid_size, &format!("river texture {k}")) {
+                Ok(image) => image,
+                Err(e) => {
+                    outputs.destroy(ctx, bindless);
+                    return Err(e);
+                }
+            };
+            bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            outputs.images.push(image);
+        }
+        Ok(outputs)
+    }
+
+    /// Bytes of one patch's two layers, tightly packed.
+    fn texel_bytes(grid_size: u32) -> u64 {
+        (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
+    }
+
+    /// Frees the textures (after the GPU is done with them) and their slots.
+    pub fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
+        for s in self.slots {
+            bindless.release(s);
+        }
+        for i in self.images {
+            ctx.retire_image(i);
+        }
+        ctx.retire_buffer(self.readback);
+    }
+}
+
 /// Computes `jobs` on the GPU in one dispatch, end to end: textures, upload, dispatch, readback. The scope
-/// "kernel" times the dispatch alone. For tests and benchmarks; the renderer keeps its textures resident instead.
+/// "kernel" times the dispatch alone. For tests; benchmarks reuse their outputs with [`run_batch_into`].
 pub fn run_batch(
     ctx: &Context,
     bindless: &mut Bindless,
@@ -417,44 +486,42 @@ pub fn run_batch(
     jobs: &[PatchJob],
     params: &KernelParams,
 ) -> Result<BatchResult, GpuError> {
+    let outputs = BatchOutputs::new(ctx, bindless, jobs.len(), kernel.grid_size)?;
+    let result = run_batch_into(ctx, bindless, kernel, variant, jobs, params, &outputs);
+    outputs.destroy(ctx, bindless);
+    result
+}
+
+/// [`run_batch`] into existing outputs (at least one texture per job): upload, dispatch, readback, decode.
+pub fn run_batch_into(
+    ctx: &Context,
+    bindless: &Bindless,
+    kernel: &RiverKernel,
+    variant: KernelVariant,
+    jobs: &[PatchJob],
+    params: &KernelParams,
+    outputs: &BatchOutputs,
+) -> Result<BatchResult, GpuError> {
     let n = kernel.grid_size;
-    let mut slots = Vec::with_capacity(jobs.len());
-    let mut images = Vec::with_capacity(jobs.len());
-    let release = |bindless: &mut Bindless, slots: Vec<Slot>, images: Vec<Image>| {
-        for s in slots {
-            bindless.release(s);
-        }
-        for i in images {
-            ctx.retire_image(i);
-        }
-    };
-    for k in 0..jobs.len() {
-        let Some(slot) = bindless.allocate() else {
-            release(bindless, slots, images);
-            return Err(GpuError::Invalid(format!(
-                "batch of {} patches exceeds the {} bindless slots",
-                jobs.len(),
-                bindless.capacity
-            )));
-        };
-        let image = create_river_texture(ctx, n, &format!("river texture {k}"))?;
-        bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
-        slots.push(slot);
-        images.push(image);
+    if outputs.images.len() < jobs.len() || outputs.grid_size != n {
+        return Err(GpuError::Invalid(format!(
+            "batch of {} patches of {n}x{n} vertices does not fit outputs for {} patches of {}x{}",
+            jobs.len(),
+            outputs.images.len(),
+            outputs.grid_size,
+            outputs.grid_size
+        )));
     }
-    let texel_bytes = (n * n * 16 * RIVER_TEXTURE_LAYERS) as u64;
-    let readback = ctx.create_buffer(&BufferDesc {
-        name: "river readback",
-        size: texel_bytes * jobs.len() as u64,
-        usage: vk::BufferUsageFlags::TRANSFER_DST,
-        location: MemoryLocation::GpuToCpu,
-    })?;
+    let texel_bytes = BatchOutputs::texel_bytes(n);
+    let images = &outputs.images[..jobs.len()];
+    let slots = &outputs.slots[..jobs.len()];
+    let readback = &outputs.readback;
     let mut profiler = Profiler::new(ctx, 2, "river kernel timestamps")?;
     let image_refs: Vec<&Image> = images.iter().collect();
     let result = ctx.run_and_wait("river kernel batch", |rec| {
         let batch = KernelBatch {
             textures: &image_refs,
-            slots: &slots,
+            slots,
             jobs,
         };
         let scope = profiler.begin(rec, "kernel")?;
@@ -470,12 +537,12 @@ pub fn run_batch(
             rec.copy_image_to_buffer(
                 image,
                 vk::ImageLayout::GENERAL,
-                &readback,
+                readback,
                 k as u64 * texel_bytes,
             );
         }
         rec.buffer_barrier(
-            &readback,
+            readback,
             vk::PipelineStageFlags2::COPY,
             vk::AccessFlags2::TRANSFER_WRITE,
             vk::PipelineStageFlags2::HOST,
@@ -501,7 +568,5 @@ pub fn run_batch(
         })
     });
     profiler.destroy(ctx);
-    ctx.retire_buffer(readback);
-    release(bindless, slots, images);
     outcome
 }
