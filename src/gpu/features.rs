@@ -104,14 +104,14 @@ pub fn query(
             b(v13.maintenance4),
         ),
         (
-            "subgroup basic, ballot and arithmetic operations in compute shaders",
+            "subgroup ballot + arithmetic in compute",
             subgroup
                 .supported_stages
                 .contains(vk::ShaderStageFlags::COMPUTE)
                 && subgroup.supported_operations.contains(subgroup_ops),
         ),
         (
-            "subgroupSizeControl, computeFullSubgroups and a required subgroup size in compute",
+            "computeFullSubgroups + requiredSubgroupSize",
             b(v13.subgroup_size_control)
                 && b(v13.compute_full_subgroups)
                 && subgroup
