@@ -169,16 +169,13 @@ impl EnabledFeatures {
     }
 }
 
-/// What the device's subgroups can do, and their sizes (the tiled river kernel shares samples across a subgroup).
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+/// What the device's subgroups can do, and their largest size (the tiled river kernel shares samples across a
+/// subgroup and requires full subgroups of that size).
+#[derive(Clone, Copy, Debug, Default)]
 pub struct SubgroupProperties {
-    #[serde(skip)]
     pub supported_stages: vk::ShaderStageFlags,
-    #[serde(skip)]
     pub supported_operations: vk::SubgroupFeatureFlags,
-    #[serde(skip)]
     pub required_size_stages: vk::ShaderStageFlags,
-    pub min_size: u32,
     pub max_size: u32,
 }
 
@@ -198,7 +195,6 @@ pub fn subgroup_properties(
         supported_stages: v11.subgroup_supported_stages,
         supported_operations: v11.subgroup_supported_operations,
         required_size_stages: v13.required_subgroup_size_stages,
-        min_size: v13.min_subgroup_size,
         max_size: v13.max_subgroup_size,
     }
 }

@@ -275,8 +275,7 @@ impl RiverKernel {
         for (job, row) in jobs.iter().zip(&table) {
             sample_buffer.write(row.sample_offset as usize * sample_bytes, job.samples)?;
         }
-        let jobs = &table[..];
-        let mut bytes = sample_buffer.size + job_buffer.size;
+        let bytes = sample_buffer.size + job_buffer.size;
         let push = PushParams {
             influence_distance: params.influence_distance,
             basin_depth: params.basin_depth,
@@ -286,51 +285,69 @@ impl RiverKernel {
         };
         let push = bytemuck::bytes_of(&push);
         let n = self.grid_size;
-        let patches = jobs.len() as u32;
-        match variant {
-            KernelVariant::Simple => {
-                let set = rec.buffer_set(&self.inputs, &[&sample_buffer, &job_buffer])?;
-                let groups = [(n * n).div_ceil(self.tuning.simple_workgroup), patches, 1];
+        let inputs = [&sample_buffer, &job_buffer];
+        let dispatched = match variant {
+            KernelVariant::Simple => rec.buffer_set(&self.inputs, &inputs).map(|set| {
+                let groups = [
+                    (n * n).div_ceil(self.tuning.simple_workgroup),
+                    table.len() as u32,
+                    1,
+                ];
                 rec.dispatch(&self.simple, &[bindless.set, set], push, groups);
-            }
-            KernelVariant::Tiled => {
-                let [bx, by] = self.tuning.tiled_block;
-                let blocks = [n.div_ceil(bx), n.div_ceil(by)];
-                let words: u64 = jobs.iter().map(|j| j.mask_words() as u64).sum();
-                let masks = ctx.create_buffer(&BufferDesc {
-                    name: "river reach masks",
-                    size: (words * (blocks[0] * blocks[1]) as u64 * 4).max(16),
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                })?;
-                bytes += masks.size;
-                let set =
-                    rec.buffer_set(&self.tiled_inputs, &[&sample_buffer, &job_buffer, &masks])?;
-                rec.fill_buffer(&masks, 0);
-                rec.buffer_barrier(
-                    &masks,
-                    vk::PipelineStageFlags2::CLEAR,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                );
-                rec.dispatch(&self.reach, &[bindless.set, set], push, [1, patches, 1]);
-                rec.buffer_barrier(
-                    &masks,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_READ,
-                );
-                let groups = [blocks[0], blocks[1], patches];
-                rec.dispatch(&self.tiled, &[bindless.set, set], push, groups);
-                rec.free_after_completion(masks);
-            }
-        }
+                0
+            }),
+            KernelVariant::Tiled => self.record_tiled(rec, bindless, inputs, &table, push),
+        };
         rec.free_after_completion(sample_buffer);
         rec.free_after_completion(job_buffer);
-        Ok(bytes)
+        Ok(bytes + dispatched?)
+    }
+
+    /// The tiled variant: clears the reach masks, runs the pre-pass that fills them, then the tiled kernel.
+    /// Returns the size of the mask buffer, which is freed when the submission completes.
+    fn record_tiled(
+        &self,
+        rec: &mut Recorder,
+        bindless: &Bindless,
+        [samples, table_buffer]: [&Buffer; 2],
+        table: &[GpuPatchJob],
+        push: &[u8],
+    ) -> Result<u64, GpuError> {
+        let n = self.grid_size;
+        let [bx, by] = self.tuning.tiled_block;
+        let blocks = [n.div_ceil(bx), n.div_ceil(by)];
+        let words: u64 = table.iter().map(|j| j.mask_words() as u64).sum();
+        let masks = rec.ctx().create_buffer(&BufferDesc {
+            name: "river reach masks",
+            size: (words * (blocks[0] * blocks[1]) as u64 * 4).max(16),
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        let size = masks.size;
+        let set = rec.buffer_set(&self.tiled_inputs, &[samples, table_buffer, &masks]);
+        if let Ok(set) = set {
+            let patches = table.len() as u32;
+            rec.fill_buffer(&masks, 0);
+            rec.buffer_barrier(
+                &masks,
+                vk::PipelineStageFlags2::CLEAR,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            rec.dispatch(&self.reach, &[bindless.set, set], push, [1, patches, 1]);
+            rec.buffer_barrier(
+                &masks,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ,
+            );
+            let groups = [blocks[0], blocks[1], patches];
+            rec.dispatch(&self.tiled, &[bindless.set, set], push, groups);
+        }
+        rec.free_after_completion(masks);
+        set.map(|_| size)
     }
 
     pub fn destroy(self, ctx: &Context) {
