@@ -171,9 +171,9 @@ enum BenchCommand {
         /// Invocations per workgroup of the simple kernel.
         #[arg(long, default_value_t = KernelTuning::default().simple_workgroup)]
         simple_workgroup: u32,
-        /// Vertex block per workgroup of the tiled kernel, as WxH.
-        #[arg(long, default_value = "8x4", value_parser = parse_block)]
-        tiled_block: [u32; 2],
+        /// Vertex block per workgroup of the tiled kernel, as WxH [default: 8x4, KernelTuning::default()].
+        #[arg(long, value_parser = parse_block)]
+        tiled_block: Option<[u32; 2]>,
         /// Samples staged per tile by the tiled kernel.
         #[arg(long, default_value_t = KernelTuning::default().tile_size)]
         tile_size: u32,
@@ -424,7 +424,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             let ctx = Context::new(options)?;
             let tuning = KernelTuning {
                 simple_workgroup,
-                tiled_block,
+                tiled_block: tiled_block.unwrap_or(KernelTuning::default().tiled_block),
                 tile_size,
             };
             let report =

@@ -191,30 +191,39 @@ impl Recorder<'_> {
         push: &[u8],
         groups: [u32; 3],
     ) {
-        let device = &self.ctx().device;
-        // SAFETY: recording; sets match the pipeline layout (validated by the layer).
+        self.bind(
+            vk::PipelineBindPoint::COMPUTE,
+            (pipeline.pipeline, pipeline.layout),
+            sets,
+            (vk::ShaderStageFlags::COMPUTE, push),
+        );
+        // SAFETY: recording; the pipeline is bound.
         unsafe {
-            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+            self.ctx()
+                .device
+                .cmd_dispatch(self.cmd, groups[0], groups[1], groups[2])
+        };
+    }
+
+    /// Binds a pipeline, its descriptor sets (from set 0) and its push constants for `stages`; empty sets or
+    /// constants are skipped.
+    fn bind(
+        &mut self,
+        point: vk::PipelineBindPoint,
+        (pipeline, layout): (vk::Pipeline, vk::PipelineLayout),
+        sets: &[vk::DescriptorSet],
+        (stages, push): (vk::ShaderStageFlags, &[u8]),
+    ) {
+        let device = &self.ctx().device;
+        // SAFETY: recording; sets and constants match the layout (validated by the layer).
+        unsafe {
+            device.cmd_bind_pipeline(self.cmd, point, pipeline);
             if !sets.is_empty() {
-                device.cmd_bind_descriptor_sets(
-                    self.cmd,
-                    vk::PipelineBindPoint::COMPUTE,
-                    pipeline.layout,
-                    0,
-                    sets,
-                    &[],
-                );
+                device.cmd_bind_descriptor_sets(self.cmd, point, layout, 0, sets, &[]);
             }
             if !push.is_empty() {
-                device.cmd_push_constants(
-                    self.cmd,
-                    pipeline.layout,
-                    vk::ShaderStageFlags::COMPUTE,
-                    0,
-                    push,
-                );
+                device.cmd_push_constants(self.cmd, layout, stages, 0, push);
             }
-            device.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
         }
     }
 }
@@ -475,24 +484,18 @@ impl Recorder<'_> {
         if range.is_empty() || instances.is_empty() {
             return;
         }
-        let device = &self.ctx().device;
         let stages = vk::ShaderStageFlags::VERTEX
             | vk::ShaderStageFlags::GEOMETRY
             | vk::ShaderStageFlags::FRAGMENT;
-        // SAFETY: recording inside a rendering scope; sets match the layout (validated by the layer).
+        self.bind(
+            vk::PipelineBindPoint::GRAPHICS,
+            (pipeline.pipeline, pipeline.layout),
+            sets,
+            (stages, push),
+        );
+        let device = &self.ctx().device;
+        // SAFETY: recording inside a rendering scope; the pipeline is bound.
         unsafe {
-            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
-            device.cmd_bind_descriptor_sets(
-                self.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                pipeline.layout,
-                0,
-                sets,
-                &[],
-            );
-            if !push.is_empty() {
-                device.cmd_push_constants(self.cmd, pipeline.layout, stages, 0, push);
-            }
             device.cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32);
             device.cmd_draw_indexed(
                 self.cmd,
