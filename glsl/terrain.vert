@@ -22,6 +22,14 @@ const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0),
 const vec3 FACE_U[6] = vec3[](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0), vec3(1, 0, 0), vec3(1, 0, 0), vec3(-1, 0, 0));
 const vec3 FACE_V[6] = vec3[](vec3(0, 1, 0), vec3(0, 1, 0), vec3(0, 0, -1), vec3(0, 0, 1), vec3(0, 1, 0), vec3(0, 1, 0));
 
+// Texture coordinates of a grid position in the base-height texture, which has a border of HEIGHT_BORDER points
+// (planet::detail::BORDER) on each side.
+const float HEIGHT_BORDER = 2.0;
+vec3 baseCoord(vec2 t) {
+    float n = frame.planet.y;
+    return vec3((t + 0.5 + HEIGHT_BORDER) / (n + 2.0 * HEIGHT_BORDER), 0.0);
+}
+
 vec3 directionAt(PatchInstance p, vec2 grid) {
     float n = frame.planet.y;
     vec2 uv = p.uvRect.xy + grid / (n - 1.0) * p.uvRect.z;
@@ -33,7 +41,7 @@ vec3 directionAt(PatchInstance p, vec2 grid) {
 float heightAt(PatchInstance p, vec2 grid) {
     float n = frame.planet.y;
     vec2 t = p.texRect.xy + grid * p.texRect.z;
-    float base = textureLod(patchTextures[nonuniformEXT(p.slots.x)], vec3((t + 1.5) / (n + 2.0), 0.0), 0.0).r;
+    float base = textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
     if (p.slots.y < 0) return base;
     vec2 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3((t + 0.5) / n, 0.0), 0.0).xy;
     return mix(river.x, base, river.y);
@@ -43,7 +51,7 @@ float heightAt(PatchInstance p, vec2 grid) {
 vec4 surfaceAt(PatchInstance p, vec2 grid, out float baseHeight) {
     float n = frame.planet.y;
     vec2 t = p.texRect.xy + grid * p.texRect.z;
-    baseHeight = textureLod(patchTextures[nonuniformEXT(p.slots.x)], vec3((t + 1.5) / (n + 2.0), 0.0), 0.0).r;
+    baseHeight = textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
     if (p.slots.y < 0) return vec4(baseHeight, frame.sun.w, 1e9, 0.0);
     vec2 uv = (t + 0.5) / n;
     vec4 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3(uv, 0.0), 0.0);

@@ -31,6 +31,11 @@ pub enum ConfigError {
     },
 }
 
+/// The deepest `max-level-of-detail` accepted (33 vertices per patch edge allow 25: see MAX_LATTICE_CELLS).
+pub const MAX_LEVEL_OF_DETAIL: u32 = 26;
+/// Lattice cells per face edge at the deepest level, at most.
+pub const MAX_LATTICE_CELLS: u32 = 1 << 30;
+
 /// `<planet-attributes>`: Table 6.1 plus the base-terrain parameters of Chapter 4.
 #[derive(Clone, Debug, Serialize)]
 pub struct PlanetConfig {
@@ -555,7 +560,7 @@ impl Config {
                 &g.max_level_of_detail,
                 dg.max_level_of_detail,
                 0,
-                20,
+                MAX_LEVEL_OF_DETAIL,
             )?,
             level_of_detail_switch_factor: r.f32(
                 "level-of-detail-switch-factor",
@@ -578,6 +583,19 @@ impl Config {
                 1 << 16,
             )?,
         };
+        // Lattice keys are 32-bit signed integers on the GPU (planet::detail): the finest lattice must keep its
+        // cells per face edge, with the border, below 2^31.
+        let deepest = MAX_LATTICE_CELLS.ilog2() - (rendering.vertices - 1).ilog2();
+        if rendering.max_level_of_detail > deepest {
+            return Err(r.error(
+                "max-level-of-detail",
+                &rendering.max_level_of_detail.to_string(),
+                format!(
+                    "must be at most {deepest} with vertices {} (at most 2^30 lattice cells per face edge)",
+                    rendering.vertices
+                ),
+            ));
+        }
         Ok(Self {
             planet,
             river,

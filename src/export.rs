@@ -9,6 +9,7 @@ use serde_json::json;
 
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},
+    heights::FaceLattice,
     Planet,
 };
 
@@ -25,14 +26,21 @@ fn write_err(path: &Path, e: impl std::fmt::Display) -> ExportError {
     }
 }
 
-/// Writes `dir/faces/face{0..5}.png` (16-bit grey, one pixel per finest-level vertex, `min_height..max_height`
-/// mapped to 0..65535; pixel (i, j) is lattice point u = -1 + i step, v = -1 + j step) and `dir/faces/layout.json`.
-pub fn write_faces(planet: &Planet, dir: &Path) -> Result<(), ExportError> {
+/// Writes `dir/faces/face{0..5}.png` (16-bit grey, one pixel per vertex of `lattice`'s level, its lowest to
+/// highest height mapped to 0..65535; pixel (i, j) is lattice point u = -1 + i step, v = -1 + j step) and
+/// `dir/faces/layout.json` (with the level and the height range).
+pub fn write_faces(lattice: &FaceLattice, level: u32, dir: &Path) -> Result<(), ExportError> {
     let faces_dir = dir.join("faces");
     fs::create_dir_all(&faces_dir).map_err(|e| write_err(&faces_dir, e))?;
-    let lattice = &planet.heights;
     let side = lattice.side() as u32;
-    let (lo, hi) = (planet.stats.min_height, planet.stats.max_height);
+    let (lo, hi) = lattice
+        .data
+        .par_iter()
+        .fold(
+            || (f32::MAX, f32::MIN),
+            |(lo, hi), &h| (lo.min(h), hi.max(h)),
+        )
+        .reduce(|| (f32::MAX, f32::MIN), |a, b| (a.0.min(b.0), a.1.max(b.1)));
     let scale = if hi > lo { 65535.0 / (hi - lo) } else { 0.0 };
     (0..FACES).into_par_iter().try_for_each(|face| {
         let image: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_fn(side, side, |i, j| {
@@ -65,8 +73,13 @@ pub fn write_faces(planet: &Planet, dir: &Path) -> Result<(), ExportError> {
         })
         .collect();
     let path = faces_dir.join("layout.json");
-    let text = serde_json::to_string_pretty(&json!({ "faces": layout }))
-        .map_err(|e| write_err(&path, e))?;
+    let text = serde_json::to_string_pretty(&json!({
+        "level": level,
+        "min_height": lo,
+        "max_height": hi,
+        "faces": layout,
+    }))
+    .map_err(|e| write_err(&path, e))?;
     fs::write(&path, text).map_err(|e| write_err(&path, e))
 }
 

@@ -5,7 +5,8 @@
 //! - app: `world` (planet + rivers from a configuration), `bench`, `export`, and the `riverplanet` binary;
 //! - `render`: the frame loop, terrain and water pipelines, offscreen targets, the viewer;
 //! - `runtime`: level of detail, culling, camera, patch cache;
-//! - `kernel`: the river-height kernel (CPU reference and GPU dispatch);
+//! - `kernel`: the river-height kernel (CPU reference and GPU dispatch); `refine`: base heights on demand on the
+//!   GPU (its CPU reference is `planet::detail`);
 //! - model: `planet`, `river`, `config`, `rng`;
 //! - `gpu`: the only module that imports ash; it knows nothing of planets.
 
@@ -15,6 +16,7 @@ pub mod export;
 pub mod gpu;
 pub mod kernel;
 pub mod planet;
+pub mod refine;
 pub mod render;
 pub mod river;
 pub mod rng;

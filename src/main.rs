@@ -51,6 +51,10 @@ enum Command {
         /// Also write DIR/continents.png, land and sea as an equirectangular image (input for continents-from-file).
         #[arg(long)]
         equirect: bool,
+        /// Level of detail of the face images (32 x 2^N + 1 pixels per edge with 33 vertices), made by the same
+        /// on-demand refinement as the renderer's patches. Default: 6, or max-level-of-detail if lower.
+        #[arg(long)]
+        level: Option<u32>,
     },
     /// Render one image headless (no display, no window system) and print per-pass GPU times.
     Render(RenderArgs),
@@ -228,7 +232,8 @@ fn main() -> ExitCode {
             seed,
             preview,
             equirect,
-        } => match generate(&config, &out, seed, preview, equirect) {
+            level,
+        } => match generate(&config, &out, seed, (preview, equirect), level) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e:#}");
@@ -567,15 +572,34 @@ fn parse_block(text: &str) -> Result<[u32; 2], String> {
     Ok([parse(w)?, parse(h)?])
 }
 
+/// The finest level `generate` writes face images at (8193 pixels per edge with 33 vertices).
+const MAX_FACE_IMAGE_LEVEL: u32 = 8;
+/// The level of `generate`'s face images without `--level` (the thesis's finest precomputed level).
+const DEFAULT_FACE_IMAGE_LEVEL: u32 = 6;
+
 fn generate(
     config_path: &std::path::Path,
     out: &std::path::Path,
     seed: Option<u32>,
-    preview: bool,
-    equirect: bool,
+    (preview, equirect): (bool, bool),
+    level: Option<u32>,
 ) -> anyhow::Result<()> {
     use std::io::IsTerminal;
     let config = load_config(config_path)?;
+    let deepest = config
+        .rendering
+        .max_level_of_detail
+        .min(MAX_FACE_IMAGE_LEVEL);
+    let level = level.unwrap_or(DEFAULT_FACE_IMAGE_LEVEL.min(deepest));
+    if level > deepest {
+        anyhow::bail!(
+            "--level {level} must be in [0, {deepest}] (max-level-of-detail {} of {}; face images stop at \
+             level {MAX_FACE_IMAGE_LEVEL}, {} pixels per edge)",
+            config.rendering.max_level_of_detail,
+            config_path.display(),
+            ((config.rendering.vertices - 1) << MAX_FACE_IMAGE_LEVEL) + 1
+        );
+    }
     let seed = seed.unwrap_or_else(|| config.resolve_seed());
     let bar = if std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new_spinner();
@@ -603,7 +627,10 @@ fn generate(
     }
     std::fs::create_dir_all(out)
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
-    riverplanet::export::write_faces(&planet, out)?;
+    let faces = planet.face_lattice(level);
+    let faces_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = std::time::Instant::now();
+    riverplanet::export::write_faces(&faces, level, out)?;
     if preview {
         let path = out.join("preview.png");
         let mut image = riverplanet::export::preview(&planet, 256);
@@ -624,6 +651,9 @@ fn generate(
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     let mut stats = planet.stats.clone();
     stats.timings_ms.insert("rivers".to_string(), river_ms);
+    stats
+        .timings_ms
+        .insert(format!("face images level {level}"), faces_ms);
     stats
         .timings_ms
         .insert("write".to_string(), t.elapsed().as_secs_f64() * 1e3);

@@ -13,6 +13,51 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
 }
 
 #[test]
+fn generate_writes_face_images_at_the_chosen_level_or_names_the_valid_range() {
+    let dir = temp_dir("generate-level");
+    let config = dir.join("deep.xml");
+    std::fs::write(
+        &config,
+        "<planet><rendering-attributes><max-level-of-detail>24</max-level-of-detail></rendering-attributes></planet>",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let run = |level: &str| {
+        riverplanet()
+            .args(["generate", "--seed", "2", "--level", level, "--config"])
+            .arg(&config)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let deep = run("5");
+    assert!(
+        deep.status.success(),
+        "{}",
+        String::from_utf8_lossy(&deep.stderr)
+    );
+    let image = image::open(out.join("faces/face3.png")).unwrap();
+    assert_eq!((image.width(), image.height()), (1025, 1025));
+    let layout: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("faces/layout.json")).unwrap())
+            .unwrap();
+    assert_eq!(layout["level"], 5);
+    // With max-level-of-detail 24 nothing is precomputed beyond level 4 (6 x 513^2 f32).
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+    assert!(
+        stats["memory_bytes"].as_u64().unwrap() <= 8 << 20,
+        "{stats}"
+    );
+    let wrong = run("9");
+    let stderr = String::from_utf8_lossy(&wrong.stderr);
+    assert!(!wrong.status.success());
+    assert!(stderr.contains("--level 9 must be in [0, 8]"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn generate_writes_faces_layout_stats_rivers_and_preview() {
     let dir = temp_dir("generate");
     let config = dir.join("small.xml");

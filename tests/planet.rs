@@ -9,7 +9,7 @@ use riverplanet::{
     },
 };
 
-/// A small planet for fast tests: max level 3 (finest lattice 257 cells per face).
+/// A small planet for fast tests: max level 3 (precomputed lattice 257 cells per face).
 fn small_config(landmass: f32) -> Config {
     let mut c = Config::default();
     c.rendering.max_level_of_detail = 3;
@@ -114,9 +114,7 @@ fn face_of_inverts_the_face_mapping() {
 /// Heights of two patches along their shared edge, in the order of the edge's points in space.
 fn edge_heights(planet: &Planet, p: PatchId, edge: Edge) -> Vec<(DVec3, f32)> {
     let n = planet.vertices;
-    let h = planet
-        .heights
-        .patch(p.face as usize, p.level as u32, p.x, p.y, n);
+    let h = planet.patch_heights(p).interior();
     (0..n)
         .map(|k| {
             let (i, j) = match edge {
@@ -195,13 +193,13 @@ fn same_seed_same_planet_and_different_seed_differs() {
     let a = Planet::generate(&c, 42, |_| {}).unwrap();
     let b = Planet::generate(&c, 42, |_| {}).unwrap();
     assert!(a
-        .heights
+        .lattice
         .data
         .iter()
-        .zip(&b.heights.data)
+        .zip(&b.lattice.data)
         .all(|(x, y)| x.to_bits() == y.to_bits()));
     let d = Planet::generate(&c, 43, |_| {}).unwrap();
-    assert!(a.heights.data != d.heights.data);
+    assert!(a.lattice.data != d.lattice.data);
 }
 
 #[test]

@@ -222,10 +222,11 @@ impl<'a> Recorder<'a> {
     }
 
     /// Copies tightly packed texels into array layer `layer` of `dst` through a staging buffer. The image must be in
-    /// TRANSFER_DST_OPTIMAL.
+    /// `layout`: TRANSFER_DST_OPTIMAL or GENERAL.
     pub fn upload_image_layer(
         &mut self,
         dst: &Image,
+        layout: vk::ImageLayout,
         layer: u32,
         data: &[u8],
     ) -> Result<(), GpuError> {
@@ -242,15 +243,11 @@ impl<'a> Recorder<'a> {
                 height: dst.extent.height,
                 depth: 1,
             });
-        // SAFETY: the image is in TRANSFER_DST_OPTIMAL (caller's contract) and alive until completion.
+        // SAFETY: the image is in `layout` (caller's contract) and alive until completion.
         unsafe {
-            self.ctx.device.cmd_copy_buffer_to_image(
-                self.cmd,
-                src,
-                dst.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[region],
-            )
+            self.ctx
+                .device
+                .cmd_copy_buffer_to_image(self.cmd, src, dst.raw, layout, &[region])
         };
         Ok(())
     }

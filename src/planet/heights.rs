@@ -1,5 +1,7 @@
-//! Height data (Sections 3.6 and 4.2): one lattice per face at the finest level of detail, holding every level at
-//! once (level L is every 2^(max - L)-th point, because diamond-square never changes a point once created).
+//! Whole-face height lattices (Sections 3.6 and 4.2): the precomputed coarse levels (continents, mountains and the
+//! first diamond-square levels), and face images assembled at any level. A lattice of level L holds every coarser
+//! level as a sub-sampling (level K is every 2^(L - K)-th point), because diamond-square never changes a point
+//! once created. Finer levels are made per patch on demand (`detail`), by the same rule.
 //!
 //! Seams: every lattice point is identified by its integer position on the cube, shared by the faces that meet
 //! there. Its random displacement is a hash of that position, and its average sums its four neighbours in
@@ -9,10 +11,10 @@
 use glam::{DVec3, I64Vec3};
 use rayon::prelude::*;
 
-use super::cube::{FACES, FACE_AXES};
-use crate::rng;
-
-const STREAM_DIAMOND_SQUARE: u64 = 0xD5_0001;
+use super::{
+    cube::{PatchId, FACES, FACE_AXES},
+    detail::{self, sorted_average, DetailRule, PatchHeights},
+};
 
 /// Heights of the six faces at `cells` cells per face edge: `(cells + 1)^2` values per face, row-major (j rows of
 /// i), with u = -1 + 2 i / cells and v = -1 + 2 j / cells.
@@ -90,28 +92,15 @@ impl FaceLattice {
         self.locate(key).map_or(0.0, |(f, i, j)| self.get(f, i, j))
     }
 
-    /// Runs one diamond-square step, turning the level with stride `2 * half` into the level with stride `half`.
-    /// `amplitude` scales the random displacement of the new points.
-    pub fn diamond_square_step(&mut self, seed: u64, half: u32, amplitude: f32) {
+    /// Runs one diamond-square step, turning the level with stride `2 * half` into the level with stride `half`,
+    /// whose points are created at `level` (displacements by [`DetailRule`], as in the per-patch step).
+    pub fn diamond_square_step(&mut self, rule: &DetailRule, half: u32, level: u32) {
         let stride = 2 * half;
         let c = self.cells;
         let side = self.side();
-        let noise = |key: I64Vec3| -> f32 {
-            let h = rng::hash(
-                seed,
-                &[
-                    STREAM_DIAMOND_SQUARE,
-                    key.x as u64,
-                    key.y as u64,
-                    key.z as u64,
-                ],
-            );
-            ((h >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0) * amplitude
-        };
-        let average = |mut v: [f32; 4]| -> f32 {
-            v.sort_by(|a, b| a.total_cmp(b));
-            (v[0] + v[1] + v[2] + v[3]) * 0.25
-        };
+        // The key at the new points' level: this lattice's key divided by the stride of that level.
+        let noise = |key: I64Vec3| rule.displacement(level, key / half as i64);
+        let average = sorted_average;
 
         // Diamond step: the centre of every cell of the coarser level.
         let centres: Vec<(usize, f32)> = (0..FACES)
@@ -199,49 +188,22 @@ impl FaceLattice {
         }
     }
 
-    /// The `(n + 2) x (n + 2)` heights of a patch with a one-vertex border taken from the neighbouring patches (on
-    /// this face or, across a face border, on the adjacent face), so that normals at patch edges see the same
-    /// neighbours on both sides. At a cube corner the missing diagonal neighbour repeats the nearest border value.
-    pub fn patch_with_border(&self, face: usize, level: u32, x: u32, y: u32, n: u32) -> Vec<f32> {
-        let span = self.cells >> level;
-        let stride = (span / (n - 1)) as i64;
-        let c = self.cells as i64;
-        let normal = axis(FACE_AXES[face].0);
-        let (x0, y0) = ((x * span) as i64, (y * span) as i64);
-        let mut out = Vec::with_capacity(((n + 2) * (n + 2)) as usize);
-        for j in -1..=n as i64 {
-            for i in -1..=n as i64 {
-                let (gi, gj) = (x0 + i * stride, y0 + j * stride);
-                let inside = |g: i64| (0..=c).contains(&g);
-                let h = if inside(gi) && inside(gj) {
-                    self.get(face, gi as u32, gj as u32)
-                } else {
-                    // Step from the nearest border point into the adjacent face (against this face's normal).
-                    let (ci, cj) = (gi.clamp(0, c), gj.clamp(0, c));
-                    let over = (gi - ci).abs().max((gj - cj).abs());
-                    if (gi - ci) != 0 && (gj - cj) != 0 {
-                        self.get(face, ci as u32, cj as u32)
-                    } else {
-                        self.at_key(self.key(face, ci as u32, cj as u32) - normal * over)
-                    }
-                };
-                out.push(h);
-            }
-        }
-        out
-    }
-
-    /// The `n x n` heights of a patch at `level`, where a patch at level L spans `cells / 2^L` cells.
-    pub fn patch(&self, face: usize, level: u32, x: u32, y: u32, n: u32) -> Vec<f32> {
-        let span = self.cells >> level;
-        let stride = span / (n - 1);
-        let mut out = Vec::with_capacity((n * n) as usize);
-        for j in 0..n {
-            for i in 0..n {
-                out.push(self.get(face, x * span + i * stride, y * span + j * stride));
-            }
-        }
-        out
+    /// The heights of `patch` (at a level no finer than this lattice's) with its border of
+    /// [`detail::BORDER`] points: points beyond a face edge are read from the adjacent face, corner quadrants
+    /// repeat the corner (as the per-patch step writes them).
+    pub fn patch_heights(&self, patch: PatchId, n: u32) -> PatchHeights {
+        let cells = detail::lattice_cells(n, patch.level as u32);
+        let scale = self.cells as i64 / cells;
+        let face = patch.face as usize;
+        PatchHeights::from_fn(patch, n, |g| {
+            let g = if detail::in_corner_quadrant(cells, g) {
+                detail::corner_of(cells, g)
+            } else {
+                g
+            };
+            let key = detail::key(face, cells, g).expect("outside the corner quadrants");
+            self.at_key(key * scale)
+        })
     }
 }
 

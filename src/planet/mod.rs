@@ -1,7 +1,10 @@
-//! The planet model (Chapters 3 and 4): the cube-sphere, continents, mountains and diamond-square heights.
+//! The planet model (Chapters 3 and 4): the cube-sphere, continents, mountains and diamond-square heights. Only
+//! the coarse levels are precomputed ([`PRECOMPUTED_LEVEL`]); every finer patch gets its heights on demand from its
+//! parent's (`detail`).
 
 pub mod continents;
 pub mod cube;
+pub mod detail;
 pub mod heights;
 
 use std::{path::Path, time::Instant};
@@ -12,12 +15,19 @@ use serde::Serialize;
 
 use self::{
     continents::{ContinentError, ContinentImage, FeaturePoints},
+    cube::PatchId,
     cube::FACES,
+    detail::{DetailRule, PatchHeights},
     heights::{area_weight, FaceLattice},
 };
 use crate::{config::Config, rng::Rng};
 
 const STREAM_MOUNTAINS: u64 = 0x40_0001;
+
+/// The finest level precomputed at start-up (unless `max-level-of-detail` or the base lattice says otherwise):
+/// with 33 vertices a lattice of 513 points per face edge, 6 x 513^2 f32 = 6.3 MB. Finer levels are made per
+/// patch when first needed, so no start-up cost or memory depends on `max-level-of-detail`.
+pub const PRECOMPUTED_LEVEL: u32 = 4;
 
 /// Longitude and latitude in degrees of a direction: latitude from the equator towards +Y (north), longitude
 /// from +X, east (towards -Z) positive.
@@ -61,7 +71,7 @@ pub enum PlanetError {
 #[derive(Clone, Debug, Serialize)]
 pub struct PlanetStats {
     pub seed: u32,
-    /// Share of the sphere's area above sea level at the finest level, in percent.
+    /// Share of the sphere's area above sea level on the precomputed lattice, in percent.
     pub landmass_percent: f64,
     /// Share of the sphere's area that the continents (Voronoi or image, after perturbation) cover, in percent.
     pub continent_percent: f64,
@@ -71,20 +81,27 @@ pub struct PlanetStats {
     pub min_height: f32,
     pub max_height: f32,
     pub base_level: u32,
-    pub finest_cells: u32,
+    /// The level of the precomputed lattice (`memory_bytes`); finer levels are generated per patch on demand.
+    pub precomputed_level: u32,
+    pub precomputed_cells: u32,
     /// Milliseconds per stage (summed over the landmass corrections).
     pub timings_ms: std::collections::BTreeMap<String, f64>,
     pub memory_bytes: u64,
 }
 
-/// A generated planet: its heights at every level of detail, and its mountains.
+/// A generated planet: its precomputed coarse heights, the rule that refines them to any level, and its
+/// mountains.
 pub struct Planet {
     pub radius: f64,
     pub sea_level: f32,
     /// Vertices per patch edge (33).
     pub vertices: u32,
     pub max_level: u32,
-    pub heights: FaceLattice,
+    /// The heights of level `precomputed_level` (every coarser level is a sub-sampling of it).
+    pub lattice: FaceLattice,
+    pub precomputed_level: u32,
+    /// The diamond-square rule of every finer level.
+    pub rule: DetailRule,
     pub mountains: Vec<Mountain>,
     pub features: Option<FeaturePoints>,
     pub stats: PlanetStats,
@@ -121,6 +138,11 @@ impl Planet {
             *timings.entry(stage.to_string()).or_default() += ms_since(since)
         };
         let seed64 = seed as u64;
+        let precomputed_level = PRECOMPUTED_LEVEL.min(r.max_level_of_detail).max(base_level);
+        let rule = DetailRule {
+            seed,
+            amplitude: p.detail_amplitude,
+        };
 
         // Continents on the base lattice (4.1).
         let t = Instant::now();
@@ -209,7 +231,8 @@ impl Planet {
             progress("mountains");
 
             let t = Instant::now();
-            let heights = diamond_square(&base, config, base_level, seed64, &mut progress);
+            let heights =
+                diamond_square(&base, &rule, base_level, precomputed_level, &mut progress);
             time("diamond-square", t);
 
             let t = Instant::now();
@@ -219,7 +242,7 @@ impl Planet {
             if image_land.is_some() || (landmass - target).abs() <= 0.0025 || attempt == 3 {
                 break Ok(Self::finish(
                     config,
-                    heights,
+                    (heights, precomputed_level, rule),
                     mountains,
                     features,
                     PlanetStats {
@@ -236,7 +259,8 @@ impl Planet {
                         min_height,
                         max_height,
                         base_level,
-                        finest_cells: cells_per_patch << r.max_level_of_detail,
+                        precomputed_level,
+                        precomputed_cells: cells_per_patch << precomputed_level,
                         timings_ms: timings,
                         memory_bytes: 0,
                     },
@@ -248,38 +272,41 @@ impl Planet {
 
     fn finish(
         config: &Config,
-        heights: FaceLattice,
+        (lattice, precomputed_level, rule): (FaceLattice, u32, DetailRule),
         mountains: Vec<Mountain>,
         features: Option<FeaturePoints>,
         mut stats: PlanetStats,
     ) -> Self {
         stats.mountains = mountains.len();
-        stats.memory_bytes = heights.bytes();
+        stats.memory_bytes = lattice.bytes();
         log::info!("planet: {stats:?}");
         Self {
             radius: config.planet.radius as f64,
             sea_level: config.planet.sea_level_height,
             vertices: config.rendering.vertices,
             max_level: config.rendering.max_level_of_detail,
-            heights,
+            lattice,
+            precomputed_level,
+            rule,
             mountains,
             features,
             stats,
         }
     }
 
-    /// The base height at a unit direction, bilinear on the finest lattice.
+    /// The base height at a unit direction, bilinear on the precomputed lattice (finer levels add at most
+    /// `rule.remaining_range(precomputed_level)` to it).
     pub fn height_at(&self, direction: DVec3) -> f32 {
         let (face, u, v) = cube::face_of(direction);
-        let c = self.heights.cells as f64;
+        let c = self.lattice.cells as f64;
         let x = ((u + 1.0) * 0.5 * c).clamp(0.0, c);
         let y = ((v + 1.0) * 0.5 * c).clamp(0.0, c);
         let (i, j) = (
-            (x.floor() as u32).min(self.heights.cells - 1),
-            (y.floor() as u32).min(self.heights.cells - 1),
+            (x.floor() as u32).min(self.lattice.cells - 1),
+            (y.floor() as u32).min(self.lattice.cells - 1),
         );
         let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
-        let h = |di, dj| self.heights.get(face, i + di, j + dj);
+        let h = |di, dj| self.lattice.get(face, i + di, j + dj);
         let bottom = h(0, 0) * (1.0 - fx) + h(1, 0) * fx;
         let top = h(0, 1) * (1.0 - fx) + h(1, 1) * fx;
         bottom * (1.0 - fy) + top * fy
@@ -289,20 +316,79 @@ impl Planet {
     pub fn is_land(&self, direction: DVec3) -> bool {
         self.height_at(direction) > self.sea_level
     }
+
+    /// The heights of any patch on the CPU: cut from the precomputed lattice, or refined step by step from its
+    /// nearest precomputed ancestor (the reference the GPU path is tested against).
+    pub fn patch_heights(&self, patch: PatchId) -> PatchHeights {
+        if patch.level as u32 <= self.precomputed_level {
+            return self.lattice.patch_heights(patch, self.vertices);
+        }
+        let parent = self.patch_heights(patch.parent().expect("level > 0"));
+        detail::refine(&parent, patch, &self.rule)
+    }
+
+    /// Lowest and highest height any level can reach: the precomputed range widened by what finer levels add.
+    pub fn height_bounds(&self) -> (f32, f32) {
+        let extra = self.rule.remaining_range(self.precomputed_level);
+        (self.stats.min_height - extra, self.stats.max_height + extra)
+    }
+
+    /// The whole planet's heights at `level` as one lattice per face (for images): sub-sampled from the
+    /// precomputed lattice, or assembled from every patch of that level, made level by level from their
+    /// parents as the renderer makes them.
+    pub fn face_lattice(&self, level: u32) -> FaceLattice {
+        let n = self.vertices;
+        let cells = (n - 1) << level;
+        let mut out = FaceLattice::new(cells, 0.0);
+        let fill = |out: &mut FaceLattice, p: &PatchHeights| {
+            let (x0, y0) = detail::origin(p.patch, n);
+            for j in 0..n as i64 {
+                for i in 0..n as i64 {
+                    let index = out.index(p.patch.face as usize, (x0 + i) as u32, (y0 + j) as u32);
+                    out.data[index] = p.get(i, j);
+                }
+            }
+        };
+        let start = level.min(self.precomputed_level);
+        for face in 0..cube::FACES {
+            let count = 1u32 << start;
+            let mut patches: Vec<PatchHeights> = (0..count * count)
+                .map(|k| PatchId {
+                    face: face as u8,
+                    level: start as u8,
+                    x: k % count,
+                    y: k / count,
+                })
+                .map(|p| self.lattice.patch_heights(p, n))
+                .collect();
+            for _ in start..level {
+                patches = patches
+                    .par_iter()
+                    .flat_map_iter(|parent| {
+                        (0..4)
+                            .map(move |q| detail::refine(parent, parent.patch.child(q), &self.rule))
+                    })
+                    .collect();
+            }
+            for p in &patches {
+                fill(&mut out, p);
+            }
+        }
+        out
+    }
 }
 
-/// Spreads the base lattice onto the finest lattice and runs diamond-square from the base level down (3.6), the
-/// displacement halving per level.
+/// Spreads the base lattice onto the lattice of level `to` and runs diamond-square from the base level up to it
+/// (3.6), by the same rule as the per-patch step.
 fn diamond_square(
     base: &FaceLattice,
-    config: &Config,
+    rule: &DetailRule,
     base_level: u32,
-    seed: u64,
+    to: u32,
     progress: &mut impl FnMut(&str),
 ) -> FaceLattice {
-    let finest_cells = (config.rendering.vertices - 1) << config.rendering.max_level_of_detail;
-    let scale = finest_cells / base.cells;
-    let mut heights = FaceLattice::new(finest_cells, 0.0);
+    let scale = 1u32 << (to - base_level);
+    let mut heights = FaceLattice::new(base.cells * scale, 0.0);
     for f in 0..FACES {
         for j in 0..=base.cells {
             for i in 0..=base.cells {
@@ -311,13 +397,8 @@ fn diamond_square(
             }
         }
     }
-    let mut half = scale / 2;
-    let mut level = base_level;
-    while half >= 1 {
-        let amplitude = config.planet.detail_amplitude / (1u32 << (level + 1)) as f32;
-        heights.diamond_square_step(seed, half, amplitude);
-        half /= 2;
-        level += 1;
+    for level in base_level + 1..=to {
+        heights.diamond_square_step(rule, 1 << (to - level), level);
         progress("diamond-square level");
     }
     heights

@@ -1,7 +1,10 @@
 //! One frame (docs/rendering.md): level of detail, culling, river data for new patches (one kernel dispatch),
 //! then one instanced draw of all visible patches for the terrain and one for the water, each timed.
 
-use std::{collections::BTreeMap, time::Instant};
+use std::{
+    collections::{BTreeMap, HashMap},
+    time::Instant,
+};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
@@ -14,14 +17,14 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
-        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Profiler,
-        Recorder,
+        vk, Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler, Recorder,
     },
     kernel::{
         gpu::{create_river_texture, KernelBatch, KernelTuning, KernelVariant, RiverKernel},
         KernelParams, PatchJob, RiverSample,
     },
-    planet::{cube::PatchId, Planet},
+    planet::{cube::PatchId, detail::PatchHeights, Planet},
+    refine::{create_height_texture, with_ancestors, HeightRefiner, RefineJob},
     river::{
         network::RiverNetwork,
         samples::{patch_samples, PatchFrame},
@@ -114,8 +117,6 @@ pub struct FrameStats {
     pub frame_ms: f64,
 }
 
-const BASE_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
-
 fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -132,6 +133,7 @@ pub struct Renderer<'w> {
     config: Config,
     bindless: Bindless,
     kernel: RiverKernel,
+    refiner: HeightRefiner,
     terrain: GraphicsPipeline,
     water: GraphicsPipeline,
     wireframe: GraphicsPipeline,
@@ -173,6 +175,7 @@ impl<'w> Renderer<'w> {
         // Two slots per patch at most; keep the cache within what the bindless arrays hold.
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
         let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
+        let refiner = HeightRefiner::new(ctx, &bindless, n)?;
         let instance_layout = BufferSetLayout::new(ctx, 1, "patch instances")?;
         let layouts = [bindless.layout, instance_layout.layout];
         // The terrain is drawn per quadrant without a geometry shader; the water pass has the geometry shader that
@@ -214,9 +217,13 @@ impl<'w> Renderer<'w> {
             rec.upload_buffer(&indices, 0, bytemuck::cast_slice(&mesh))
         })?;
         let profiler = Profiler::new(ctx, 8, "frame timestamps")?;
+        // Culling bounds: every height any level can reach (finer levels add at most a bound to the precomputed
+        // range), with a river basin's depth and a unit of margin either way.
+        let (lowest, highest) = planet.height_bounds();
+        let margin = config.river.basin_depth as f64 + 1.0;
         let heights = HeightRange {
-            min: planet.stats.min_height as f64 - 1.0,
-            max: planet.stats.max_height as f64 + config.river.basin_depth as f64 + 1.0,
+            min: lowest as f64 - margin,
+            max: highest as f64 + margin,
         };
         Ok(Self {
             ctx,
@@ -225,6 +232,7 @@ impl<'w> Renderer<'w> {
             config: config.clone(),
             bindless,
             kernel,
+            refiner,
             terrain,
             water,
             wireframe,
@@ -304,22 +312,32 @@ impl<'w> Renderer<'w> {
         stats.selected_patches = selected.len();
         stats.visible_patches = visible.len();
 
-        // Patches without data: roots first (they stand in for everything), then coarse before fine, within the
-        // per-frame budget; the rest draw an ancestor until their turn.
-        let mut missing: Vec<PatchId> = (0..6)
-            .map(PatchId::root)
-            .filter(|p| !self.cache.contains(p))
-            .collect();
-        let roots = missing.len();
+        // Patches without data: roots first (they stand in for everything), then coarse before fine and nearest
+        // first, each after the ancestors it is refined from, within the per-frame budget; the rest draw an
+        // ancestor until their turn.
+        let roots: Vec<PatchId> = (0..6).map(PatchId::root).collect();
         let mut wanted: Vec<PatchId> = visible
             .iter()
             .map(|s| s.patch)
             .filter(|p| p.level > 0 && !self.cache.contains(p))
             .collect();
-        wanted.sort_by_key(|p| (p.level, p.face, p.y, p.x));
+        wanted.sort_by(|a, b| {
+            let distance = |p: &PatchId| camera.position.distance_squared(p.center() * radius);
+            (a.level, distance(a))
+                .partial_cmp(&(b.level, distance(b)))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
         wanted.dedup();
-        // Mark what this frame draws from (its own data or a stand-in) so that eviction leaves it, then make room:
-        // the cache never holds more than its budget, so at most that many patches get data.
+        let precomputed = self.planet.precomputed_level;
+        let forced = with_ancestors(&roots, precomputed, |p| self.cache.contains(p)).len();
+        let mut missing = with_ancestors(
+            &roots.iter().chain(&wanted).copied().collect::<Vec<_>>(),
+            precomputed,
+            |p| self.cache.contains(p),
+        );
+        // Mark what this frame draws from (its own data or a stand-in), and the resident parents that new patches
+        // are refined from, so that eviction leaves them; then make room: the cache never holds more than its
+        // budget, so at most that many patches get data.
         for s in &visible {
             let source = if self.cache.contains(&s.patch) {
                 Some(s.patch)
@@ -331,37 +349,38 @@ impl<'w> Renderer<'w> {
             }
         }
         let budget = self.config.rendering.new_patches_per_frame as usize;
-        let wanted_now = (roots + wanted.len().min(budget)).min(self.cache.capacity);
+        missing.truncate((forced + budget).min(self.cache.capacity));
+        for p in &missing {
+            if let Some(parent) = p.parent() {
+                self.cache.touch(&parent);
+            }
+        }
+        let requested = wanted.len();
         stats.evicted_patches =
             self.cache
-                .evict_to(self.cache.capacity - wanted_now, ctx, &mut self.bindless);
-        let room = self
-            .cache
-            .capacity
-            .saturating_sub(self.cache.len())
-            .saturating_sub(roots);
-        let take = budget.min(room);
-        stats.pending_patches = wanted.len().saturating_sub(take);
-        missing.extend(wanted.into_iter().take(take));
-        stats.new_patches = missing.len() - roots;
+                .evict_to(self.cache.capacity - missing.len(), ctx, &mut self.bindless);
+        let room = self.cache.capacity.saturating_sub(self.cache.len());
+        missing.truncate(room.max(forced));
+        stats.new_patches = missing.len().saturating_sub(forced);
+        stats.pending_patches =
+            requested.saturating_sub(missing.iter().filter(|p| wanted.contains(p)).count());
 
-        // Sections 6.3-6.4: base heights and river samples of the new patches, in parallel.
+        // Sections 6.3-6.4: base heights of precomputed levels (finer ones are refined on the GPU) and river
+        // samples of the new patches, in parallel.
         let t = Instant::now();
         let planet = self.planet;
         let network = self.network;
-        let prepared: Vec<(PatchId, Vec<f32>, Vec<RiverSample>)> = missing
+        let prepared: Vec<NewPatch> = missing
             .par_iter()
-            .map(|&p| {
-                let base =
-                    planet
-                        .heights
-                        .patch_with_border(p.face as usize, p.level as u32, p.x, p.y, n);
-                let samples = patch_samples(network, &PatchFrame::new(p, radius, n));
-                (p, base, samples)
+            .map(|&p| NewPatch {
+                patch: p,
+                heights: (p.level as u32 <= precomputed)
+                    .then(|| planet.lattice.patch_heights(p, n)),
+                samples: patch_samples(network, &PatchFrame::new(p, radius, n)),
             })
             .collect();
         cpu.insert("influence+samples".to_string(), ms_since(t));
-        stats.samples = prepared.iter().map(|p| p.2.len()).sum();
+        stats.samples = prepared.iter().map(|p| p.samples.len()).sum();
 
         let t = Instant::now();
         let mut rec = Recorder::begin(ctx, "frame")?;
@@ -536,7 +555,7 @@ impl<'w> Renderer<'w> {
 
         stats.resident_patches = self.cache.len();
         stats.patch_texture_bytes = self.cache.bytes();
-        stats.precomputed_height_bytes = self.planet.heights.bytes();
+        stats.precomputed_height_bytes = self.planet.lattice.bytes();
         stats.memory_bytes = stats.patch_texture_bytes
             + stats.temporary_sample_bytes
             + stats.precomputed_height_bytes;
@@ -545,12 +564,13 @@ impl<'w> Renderer<'w> {
         Ok(stats)
     }
 
-    /// Creates the textures of new patches, uploads base heights, and computes all river textures in one kernel
-    /// dispatch. Returns the temporary sample bytes and how many patches have rivers.
+    /// Creates the textures of new patches; uploads the base heights of precomputed levels and refines the rest
+    /// from their parents on the GPU (parents first, one dispatch per level); then computes all river textures in
+    /// one kernel dispatch. Returns the temporary bytes (samples, job tables) and how many patches have rivers.
     fn upload_new_patches(
         &mut self,
         rec: &mut Recorder,
-        prepared: &[(PatchId, Vec<f32>, Vec<RiverSample>)],
+        prepared: &[NewPatch],
     ) -> Result<(u64, usize), GpuError> {
         self.last_batch.clear();
         if prepared.is_empty() {
@@ -561,74 +581,111 @@ impl<'w> Renderer<'w> {
         if self.capture_batches {
             self.last_batch = prepared
                 .iter()
-                .filter(|(_, _, s)| !s.is_empty())
-                .map(|(p, _, s)| {
+                .filter(|p| !p.samples.is_empty())
+                .map(|p| {
                     (
-                        PatchFrame::new(*p, self.planet.radius, n).spacing() as f32,
-                        s.clone(),
+                        PatchFrame::new(p.patch, self.planet.radius, n).spacing() as f32,
+                        p.samples.clone(),
                     )
                 })
                 .collect();
         }
-        let mut bases: Vec<Image> = Vec::with_capacity(prepared.len());
-        for (p, _, _) in prepared {
-            bases.push(ctx.create_image(&ImageDesc {
-                name: &format!("base heights {p:?}"),
-                extent: vk::Extent2D {
-                    width: n + 2,
-                    height: n + 2,
-                },
-                layers: 1,
-                format: BASE_FORMAT,
-                usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-                aspect: vk::ImageAspectFlags::COLOR,
-                array: true,
-            })?);
+        let mut bases: Vec<(Image, Slot)> = Vec::with_capacity(prepared.len());
+        for p in prepared {
+            let image = create_height_texture(ctx, n, &format!("base heights {:?}", p.patch))?;
+            let slot = self.slot()?;
+            self.bindless
+                .write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            bases.push((image, slot));
         }
-        let base_refs: Vec<&Image> = bases.iter().collect();
+        let base_refs: Vec<&Image> = bases.iter().map(|(i, _)| i).collect();
         rec.image_transitions(
             &base_refs,
             vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            vk::ImageLayout::GENERAL,
             vk::PipelineStageFlags2::NONE,
             vk::AccessFlags2::NONE,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE,
         );
-        for ((_, heights, _), image) in prepared.iter().zip(&bases) {
-            rec.upload_image_layer(image, 0, bytemuck::cast_slice(heights))?;
+        // Lowest height of each new patch (border included): exact for uploaded ones, a bound for refined ones.
+        let mut min_heights: HashMap<PatchId, f32> = HashMap::new();
+        let mut jobs: Vec<RefineJob> = Vec::new();
+        for (p, (image, slot)) in prepared.iter().zip(&bases) {
+            let min_height = match &p.heights {
+                Some(heights) => {
+                    rec.upload_image_layer(
+                        image,
+                        vk::ImageLayout::GENERAL,
+                        0,
+                        bytemuck::cast_slice(&heights.data),
+                    )?;
+                    heights.range().0
+                }
+                None => {
+                    let parent = p.patch.parent().expect("refined patches have parents");
+                    let (parent_slot, parent_min) = match min_heights.get(&parent) {
+                        Some(&m) => (jobs_slot(prepared, &bases, parent), m),
+                        None => {
+                            let data = self.cache.touch(&parent).ok_or_else(|| {
+                                GpuError::Invalid(format!("{:?} has no resident parent", p.patch))
+                            })?;
+                            (data.base_slot, data.min_height)
+                        }
+                    };
+                    jobs.push(RefineJob {
+                        patch: p.patch,
+                        slot: *slot,
+                        parent_slot,
+                    });
+                    parent_min - self.planet.rule.remaining_range(p.patch.level as u32 - 1)
+                }
+            };
+            min_heights.insert(p.patch, min_height);
         }
-        rec.image_transitions(
-            &base_refs,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        rec.memory_barrier(
             vk::PipelineStageFlags2::COPY,
             vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_SAMPLED_READ,
+        );
+        let mut bytes = 0;
+        if !jobs.is_empty() {
+            let scope = self.profiler.begin(rec, "heights")?;
+            bytes += self
+                .refiner
+                .record(rec, &self.bindless, self.planet, &jobs)?;
+            self.profiler.end(rec, scope);
+        }
+        rec.memory_barrier(
+            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::VERTEX_SHADER
+                | vk::PipelineStageFlags2::GEOMETRY_SHADER
+                | vk::PipelineStageFlags2::FRAGMENT_SHADER,
             vk::AccessFlags2::SHADER_SAMPLED_READ,
         );
 
         let mut rivers: Vec<(Image, Slot)> = Vec::new();
         let mut patch_jobs: Vec<PatchJob> = Vec::new();
         let mut river_of: Vec<Option<usize>> = Vec::with_capacity(prepared.len());
-        for (p, _, patch_samples) in prepared {
-            if patch_samples.is_empty() {
+        for p in prepared {
+            if p.samples.is_empty() {
                 river_of.push(None);
                 continue;
             }
             let slot = self.slot()?;
-            let image = create_river_texture(ctx, n, &format!("river data {p:?}"))?;
+            let image = create_river_texture(ctx, n, &format!("river data {:?}", p.patch))?;
             self.bindless
                 .write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
             patch_jobs.push(PatchJob {
-                spacing: PatchFrame::new(*p, self.planet.radius, n).spacing() as f32,
-                samples: patch_samples,
+                spacing: PatchFrame::new(p.patch, self.planet.radius, n).spacing() as f32,
+                samples: &p.samples,
             });
             river_of.push(Some(rivers.len()));
             rivers.push((image, slot));
         }
         let slots: Vec<Slot> = rivers.iter().map(|(_, s)| *s).collect();
-        let mut bytes = 0;
         if !rivers.is_empty() {
             let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
             let batch = KernelBatch {
@@ -637,7 +694,7 @@ impl<'w> Renderer<'w> {
                 jobs: &patch_jobs,
             };
             let scope = self.profiler.begin(rec, "kernel")?;
-            bytes = self
+            bytes += self
                 .kernel
                 .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
             self.profiler.end(rec, scope);
@@ -652,19 +709,12 @@ impl<'w> Renderer<'w> {
         }
         let river_count = rivers.len();
         let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();
-        for (((p, heights, s), base), river) in prepared.iter().zip(bases).zip(river_of) {
-            let slot = self.slot()?;
-            self.bindless.write(
-                ctx,
-                slot,
-                &base,
-                false,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            );
+        for ((p, (base, slot)), river) in prepared.iter().zip(bases).zip(river_of) {
             let river = river.and_then(|k| rivers[k].take());
-            let min_height = heights.iter().copied().fold(f32::MAX, f32::min);
-            self.cache
-                .insert(*p, PatchData::new(base, slot, river, s.len(), min_height));
+            self.cache.insert(
+                p.patch,
+                PatchData::new(base, slot, river, p.samples.len(), min_heights[&p.patch]),
+            );
         }
         Ok((bytes, river_count))
     }
@@ -692,6 +742,7 @@ impl<'w> Renderer<'w> {
         ctx.retire_buffer(self.indices);
         self.profiler.destroy(ctx);
         self.kernel.destroy(ctx);
+        self.refiner.destroy(ctx);
         self.terrain.destroy(ctx);
         self.water.destroy(ctx);
         self.wireframe.destroy(ctx);
@@ -699,6 +750,23 @@ impl<'w> Renderer<'w> {
         let _ = ctx.wait_idle();
         self.bindless.destroy(ctx);
     }
+}
+
+/// A patch that gets its data this frame: base heights from the precomputed lattice (`None`: refined on the GPU
+/// from its parent's), and its river samples.
+struct NewPatch {
+    patch: PatchId,
+    heights: Option<PatchHeights>,
+    samples: Vec<RiverSample>,
+}
+
+/// The slot of `patch`'s new base texture among this frame's new patches.
+fn jobs_slot(prepared: &[NewPatch], bases: &[(Image, Slot)], patch: PatchId) -> Slot {
+    let index = prepared
+        .iter()
+        .position(|p| p.patch == patch)
+        .expect("a parent made this frame comes before its children");
+    bases[index].1
 }
 
 /// The instance that draws `selected` from `source`'s textures (itself, or an ancestor standing in).

@@ -1,0 +1,365 @@
+//! Base heights on demand on the GPU (glsl/heights_refine.comp): every patch finer than the precomputed lattice
+//! gets its heights from its parent's by one diamond-square step, in the frame's submission before the river
+//! kernel. Equal bit for bit to the CPU reference `planet::detail::refine` (tests/detail.rs).
+
+use std::collections::HashMap;
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::{
+    gpu::{
+        bindless::{Bindless, Slot},
+        pipeline::{BufferSetLayout, ComputePipeline},
+        vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+    },
+    planet::{cube::PatchId, detail::PatchHeights, Planet},
+    shaders,
+};
+
+/// Format of a patch's base-height texture: one f32 per lattice point, border included.
+pub const HEIGHT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+
+/// One row of the job table (std430 mirror of `RefineJob` in the shader).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct GpuRefineJob {
+    child_slot: i32,
+    parent_slot: i32,
+    face: i32,
+    level: i32,
+    x: i32,
+    y: i32,
+    unused: [i32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct RefinePush {
+    seed: u32,
+    amplitude: f32,
+}
+
+/// A patch to refine: its id, the slot its fresh texture is bound at, and its parent's slot.
+#[derive(Clone, Copy, Debug)]
+pub struct RefineJob {
+    pub patch: PatchId,
+    pub slot: Slot,
+    pub parent_slot: Slot,
+}
+
+/// The refinement pipeline.
+pub struct HeightRefiner {
+    pipeline: ComputePipeline,
+    jobs_layout: BufferSetLayout,
+    vertices: u32,
+}
+
+impl HeightRefiner {
+    pub fn new(ctx: &Context, bindless: &Bindless, vertices: u32) -> Result<Self, GpuError> {
+        let jobs_layout = BufferSetLayout::new(ctx, 1, "height refinement jobs")?;
+        let pipeline = ComputePipeline::new(
+            ctx,
+            shaders::HEIGHTS_REFINE_COMP,
+            "height refinement",
+            &[bindless.layout, jobs_layout.layout],
+            std::mem::size_of::<RefinePush>() as u32,
+            &[vertices - 1],
+        );
+        let pipeline = match pipeline {
+            Ok(p) => p,
+            Err(e) => {
+                jobs_layout.destroy(ctx);
+                return Err(e);
+            }
+        };
+        Ok(Self {
+            pipeline,
+            jobs_layout,
+            vertices,
+        })
+    }
+
+    /// Records the refinement of `jobs`, sorted by level, each child's parent resident or earlier in the list:
+    /// one dispatch per level (a workgroup per patch), with a barrier between levels so that a child reads its
+    /// parent's finished heights. The children's textures must be in GENERAL, bound at their slots; the caller
+    /// makes the results visible to whatever reads them next. Returns the job table's size in bytes.
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        bindless: &Bindless,
+        planet: &Planet,
+        jobs: &[RefineJob],
+    ) -> Result<u64, GpuError> {
+        if jobs.is_empty() {
+            return Ok(0);
+        }
+        debug_assert!(jobs
+            .windows(2)
+            .all(|w| w[0].patch.level <= w[1].patch.level));
+        let table: Vec<GpuRefineJob> = jobs
+            .iter()
+            .map(|j| GpuRefineJob {
+                child_slot: j.slot.0 as i32,
+                parent_slot: j.parent_slot.0 as i32,
+                face: j.patch.face as i32,
+                level: j.patch.level as i32,
+                x: j.patch.x as i32,
+                y: j.patch.y as i32,
+                unused: [0; 2],
+            })
+            .collect();
+        let push = RefinePush {
+            seed: planet.rule.seed,
+            amplitude: planet.rule.amplitude,
+        };
+        let push = bytemuck::bytes_of(&push);
+        let row = std::mem::size_of::<GpuRefineJob>();
+        let mut start = 0;
+        let mut bytes = 0;
+        while start < jobs.len() {
+            let level = jobs[start].patch.level;
+            let end = start
+                + jobs[start..]
+                    .iter()
+                    .take_while(|j| j.patch.level == level)
+                    .count();
+            if start > 0 {
+                rec.memory_barrier(
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_SAMPLED_READ,
+                );
+            }
+            let mut buffer = rec.ctx().create_buffer(&BufferDesc {
+                name: "height refinement jobs",
+                size: ((end - start) * row) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })?;
+            buffer.write(0, &table[start..end])?;
+            bytes += buffer.size;
+            let set = rec.buffer_set(&self.jobs_layout, &[&buffer]);
+            if let Ok(set) = set {
+                rec.dispatch(
+                    &self.pipeline,
+                    &[bindless.set, set],
+                    push,
+                    [(end - start) as u32, 1, 1],
+                );
+            }
+            rec.free_after_completion(buffer);
+            set?;
+            start = end;
+        }
+        Ok(bytes)
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+        self.jobs_layout.destroy(ctx);
+    }
+
+    /// Vertices per patch edge this pipeline was built for.
+    pub fn vertices(&self) -> u32 {
+        self.vertices
+    }
+}
+
+/// Creates one patch's base-height texture: `(n + 2 BORDER)^2` texels, written by upload (precomputed levels)
+/// or by the refinement shader, read by the terrain shaders and by the refinement of its children.
+pub fn create_height_texture(ctx: &Context, vertices: u32, name: &str) -> Result<Image, GpuError> {
+    let side = PatchHeights::side(vertices) as u32;
+    ctx.create_image(&ImageDesc {
+        name,
+        extent: vk::Extent2D {
+            width: side,
+            height: side,
+        },
+        layers: 1,
+        format: HEIGHT_FORMAT,
+        usage: vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC,
+        aspect: vk::ImageAspectFlags::COLOR,
+        array: true,
+    })
+}
+
+/// The patches to make so that `wanted` can be refined: each with every ancestor finer than the precomputed
+/// level, parents first, without repeats, skipping what `resident` already has.
+pub fn with_ancestors(
+    wanted: &[PatchId],
+    precomputed_level: u32,
+    resident: impl Fn(&PatchId) -> bool,
+) -> Vec<PatchId> {
+    let mut out: Vec<PatchId> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for &patch in wanted {
+        let mut chain = Vec::new();
+        let mut p = Some(patch);
+        while let Some(q) = p {
+            if resident(&q) || seen.contains(&q) {
+                break;
+            }
+            chain.push(q);
+            if q.level as u32 <= precomputed_level {
+                break;
+            }
+            p = q.parent();
+        }
+        for q in chain.into_iter().rev() {
+            seen.insert(q);
+            out.push(q);
+        }
+    }
+    out.sort_by_key(|p| p.level);
+    out
+}
+
+/// Makes `patches` and every ancestor they need on the GPU (the precomputed ones uploaded from the planet's
+/// lattice, the rest refined level by level) and reads their heights back. For tests and tools: the renderer
+/// records the same work into its frames.
+pub fn generate_on_gpu(
+    ctx: &Context,
+    bindless: &mut Bindless,
+    refiner: &HeightRefiner,
+    planet: &Planet,
+    patches: &[PatchId],
+) -> Result<Vec<PatchHeights>, GpuError> {
+    let n = refiner.vertices;
+    let all = with_ancestors(patches, planet.precomputed_level, |_| false);
+    let mut images: Vec<Image> = Vec::with_capacity(all.len());
+    let mut slots: HashMap<PatchId, Slot> = HashMap::new();
+    let release = |images: Vec<Image>, slots: HashMap<PatchId, Slot>, bindless: &mut Bindless| {
+        for s in slots.into_values() {
+            bindless.release(s);
+        }
+        for i in images {
+            ctx.retire_image(i);
+        }
+    };
+    for p in &all {
+        let Some(slot) = bindless.allocate() else {
+            let capacity = bindless.capacity;
+            release(images, slots, bindless);
+            return Err(GpuError::Invalid(format!(
+                "{} patches exceed the {capacity} bindless slots",
+                all.len()
+            )));
+        };
+        slots.insert(*p, slot);
+        match create_height_texture(ctx, n, &format!("base heights {p:?}")) {
+            Ok(image) => {
+                bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+                images.push(image);
+            }
+            Err(e) => {
+                release(images, slots, bindless);
+                return Err(e);
+            }
+        }
+    }
+    let texel_bytes = (PatchHeights::side(n).pow(2) * 4) as u64;
+    let readback = ctx.create_buffer(&BufferDesc {
+        name: "height readback",
+        size: texel_bytes * patches.len().max(1) as u64,
+        usage: vk::BufferUsageFlags::TRANSFER_DST,
+        location: MemoryLocation::GpuToCpu,
+    });
+    let readback = match readback {
+        Ok(b) => b,
+        Err(e) => {
+            release(images, slots, bindless);
+            return Err(e);
+        }
+    };
+    let bindless_ref = &*bindless;
+    let result = ctx.run_and_wait("height refinement", |rec| {
+        let refs: Vec<&Image> = images.iter().collect();
+        rec.image_transitions(
+            &refs,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        );
+        let mut jobs = Vec::new();
+        for (p, image) in all.iter().zip(&images) {
+            if p.level as u32 <= planet.precomputed_level {
+                let heights = planet.lattice.patch_heights(*p, n);
+                rec.upload_image_layer(
+                    image,
+                    vk::ImageLayout::GENERAL,
+                    0,
+                    bytemuck::cast_slice(&heights.data),
+                )?;
+            } else {
+                let parent = p.parent().expect("refined patches have parents");
+                jobs.push(RefineJob {
+                    patch: *p,
+                    slot: slots[p],
+                    parent_slot: slots[&parent],
+                });
+            }
+        }
+        rec.memory_barrier(
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_SAMPLED_READ,
+        );
+        refiner.record(rec, bindless_ref, planet, &jobs)?;
+        rec.memory_barrier(
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_READ,
+        );
+        for (k, p) in patches.iter().enumerate() {
+            let index = all
+                .iter()
+                .position(|q| q == p)
+                .expect("every wanted patch is made");
+            rec.copy_image_to_buffer(
+                &images[index],
+                vk::ImageLayout::GENERAL,
+                &readback,
+                k as u64 * texel_bytes,
+            );
+        }
+        rec.buffer_barrier(
+            &readback,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+        Ok(())
+    });
+    let out = result.and_then(|()| {
+        let bytes = readback
+            .mapped()
+            .ok_or_else(|| GpuError::Invalid("readback buffer is not host-visible".into()))?;
+        Ok(patches
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let start = k * texel_bytes as usize;
+                let texels: &[f32] =
+                    bytemuck::cast_slice(&bytes[start..start + texel_bytes as usize]);
+                PatchHeights {
+                    patch: *p,
+                    n,
+                    data: texels.to_vec(),
+                }
+            })
+            .collect())
+    });
+    ctx.retire_buffer(readback);
+    release(images, slots, bindless);
+    out
+}

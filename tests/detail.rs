@@ -1,0 +1,220 @@
+//! Base heights on demand: the per-patch diamond-square step against the whole-face lattice, seams by lattice key
+//! at deep levels (patch borders, face borders, cube corners), and the GPU step against the CPU reference.
+
+mod common;
+
+use std::collections::HashMap;
+
+use riverplanet::{
+    config::Config,
+    gpu::bindless::Bindless,
+    planet::{
+        cube::{PatchId, FACES},
+        detail::{self, PatchHeights, BORDER},
+        Planet,
+    },
+    refine::{generate_on_gpu, HeightRefiner},
+};
+
+/// A planet whose precomputed lattice is level 4 and whose base lattice is level 1, so that levels 2-4 exist both
+/// as the whole-face diamond-square and as per-patch refinement.
+fn planet(max_level: u32, seed: u32) -> Planet {
+    let mut c = Config::default();
+    c.rendering.max_level_of_detail = max_level;
+    c.planet.base_resolution = 65;
+    Planet::generate(&c, seed, |_| {}).unwrap()
+}
+
+/// Every stored point of `patches` that is a lattice point (not in a corner quadrant), by cube key.
+fn by_key(planet: &Planet, patches: &[PatchHeights]) -> Vec<([i64; 3], f32, PatchId)> {
+    let n = planet.vertices;
+    let mut out = Vec::new();
+    for p in patches {
+        let level = p.patch.level as u32;
+        let cells = detail::lattice_cells(n, level);
+        let (x0, y0) = detail::origin(p.patch, n);
+        for j in -BORDER..n as i64 + BORDER {
+            for i in -BORDER..n as i64 + BORDER {
+                if let Some(k) = detail::key(p.patch.face as usize, cells, (x0 + i, y0 + j)) {
+                    out.push((k.to_array(), p.get(i, j), p.patch));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Fails unless every lattice point held by several patches (of one level) has the same bits in all of them;
+/// returns how many points were shared.
+fn assert_seams_agree(planet: &Planet, patches: &[PatchHeights]) -> usize {
+    let mut seen: HashMap<[i64; 3], (f32, PatchId)> = HashMap::new();
+    let mut shared = 0;
+    for (key, h, patch) in by_key(planet, patches) {
+        match seen.get(&key) {
+            Some(&(other, owner)) => {
+                shared += 1;
+                assert_eq!(
+                    h.to_bits(),
+                    other.to_bits(),
+                    "key {key:?}: {patch:?} has {h}, {owner:?} has {other}"
+                );
+            }
+            None => {
+                seen.insert(key, (h, patch));
+            }
+        }
+    }
+    shared
+}
+
+/// The patches of `level` around the cube corner shared by faces 0 (+X), 2 (+Y) and 5 (-Z) at (+X, +Y, -Z)...
+/// and, for every face, its corner patch at (0, 0) and a patch on its west edge, with same-level neighbours.
+fn corner_and_edge_patches(level: u8) -> Vec<PatchId> {
+    let last = (1u32 << level) - 1;
+    let mut out = Vec::new();
+    for face in 0..FACES as u8 {
+        for (x, y) in [
+            (0, 0),
+            (last, last),
+            (0, last),
+            (last, 0),
+            (0, last / 2),
+            (1.min(last), 0),
+        ] {
+            out.push(PatchId { face, level, x, y });
+        }
+    }
+    out.sort();
+    out.dedup();
+    out
+}
+
+#[test]
+fn refined_patches_equal_the_whole_face_diamond_square() {
+    // Levels 2-4 of the precomputed lattice are the whole-face step; the same levels refined per patch from
+    // level 1 must give the same bits everywhere, borders included (the folding across face edges and the turn
+    // about cube corners are what make the borders right).
+    let planet = planet(4, 3);
+    assert_eq!(planet.precomputed_level, 4);
+    let n = planet.vertices;
+    for face in 0..FACES as u8 {
+        let mut level_patches: Vec<PatchHeights> = (0..4)
+            .map(|k| PatchId {
+                face,
+                level: 1,
+                x: k % 2,
+                y: k / 2,
+            })
+            .map(|p| planet.lattice.patch_heights(p, n))
+            .collect();
+        for level in 2..=4u32 {
+            level_patches = level_patches
+                .iter()
+                .flat_map(|parent| {
+                    (0..4).map(|q| detail::refine(parent, parent.patch.child(q), &planet.rule))
+                })
+                .collect();
+            for refined in &level_patches {
+                let cut = planet.lattice.patch_heights(refined.patch, n);
+                let cells = detail::lattice_cells(n, level);
+                let (x0, y0) = detail::origin(refined.patch, n);
+                for j in -BORDER..n as i64 + BORDER {
+                    for i in -BORDER..n as i64 + BORDER {
+                        if detail::in_corner_quadrant(cells, (x0 + i, y0 + j)) {
+                            continue;
+                        }
+                        assert_eq!(
+                            refined.get(i, j).to_bits(),
+                            cut.get(i, j).to_bits(),
+                            "{:?} point ({i}, {j}): refined {} vs whole-face {}",
+                            refined.patch,
+                            refined.get(i, j),
+                            cut.get(i, j)
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn seams_are_bit_equal_at_deep_levels_across_faces_and_corners() {
+    let planet = planet(20, 7);
+    for level in [6u8, 12, 20] {
+        let patches: Vec<PatchHeights> = corner_and_edge_patches(level)
+            .into_iter()
+            .flat_map(|p| {
+                let mut v = vec![p];
+                v.extend(riverplanet::planet::cube::EDGES.map(|e| p.neighbour(e)));
+                v
+            })
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .map(|p| planet.patch_heights(p))
+            .collect();
+        let shared = assert_seams_agree(&planet, &patches);
+        // Each of the 8 cube corners is held by three patches, and every patch edge by two.
+        assert!(shared > 1000, "level {level}: only {shared} shared points");
+    }
+}
+
+#[test]
+fn detail_continues_at_every_depth() {
+    // Heights keep changing between levels (the displacement halves per level, it never stops), and a deep patch
+    // is not flat.
+    let planet = planet(24, 11);
+    let mut p = PatchId {
+        face: 4,
+        level: 24,
+        x: 5 << 20,
+        y: 9 << 20,
+    };
+    let deep = planet.patch_heights(p);
+    let (lo, hi) = deep.range();
+    assert!(hi > lo, "level 24 patch is flat");
+    // Relief scales with the patch: the range at level 24 is about 2^-20 of that at level 4.
+    p = PatchId {
+        face: 4,
+        level: 4,
+        x: 5,
+        y: 9,
+    };
+    let coarse = planet.patch_heights(p).range();
+    assert!(hi - lo < (coarse.1 - coarse.0) * 1e-3);
+    // Every height stays within the planet's bounds.
+    let (min, max) = planet.height_bounds();
+    assert!(lo >= min && hi <= max, "{lo}..{hi} outside {min}..{max}");
+}
+
+#[test]
+fn gpu_refinement_equals_the_cpu_reference_bit_for_bit() {
+    let Some(ctx) = common::gpu() else { return };
+    let planet = planet(20, 5);
+    let mut bindless = Bindless::new(ctx, 1024).unwrap();
+    let refiner = HeightRefiner::new(ctx, &bindless, planet.vertices).unwrap();
+    for level in [6u8, 12, 20] {
+        let wanted = corner_and_edge_patches(level);
+        let gpu = generate_on_gpu(ctx, &mut bindless, &refiner, &planet, &wanted).unwrap();
+        for g in &gpu {
+            let cpu = planet.patch_heights(g.patch);
+            let differing = g
+                .data
+                .iter()
+                .zip(&cpu.data)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count();
+            assert_eq!(
+                differing, 0,
+                "{:?}: {differing} texels differ from the CPU reference",
+                g.patch
+            );
+        }
+        let shared = assert_seams_agree(&planet, &gpu);
+        assert!(shared > 0, "level {level}");
+    }
+    common::assert_no_validation_errors(ctx);
+    ctx.wait_idle().unwrap();
+    refiner.destroy(ctx);
+    bindless.destroy(ctx);
+}
