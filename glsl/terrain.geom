@@ -47,10 +47,10 @@ void main() {
     bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && spacing >= widest);
     bool riverWater = inBasin && !paint;
     if (!riverWater && !belowSea) return;
-    float radius = frame.planet.x;
     for (int k = 0; k < 3; ++k) {
         float water = riverWater ? vRiver[k].y : seaLevel;
-        vec3 position = p.centreRel.xyz + (vDirection[k] - p.centreDir.xyz) * radius + vDirection[k] * water;
+        // Up from the terrain vertex to the water (a small difference: precise at any planet size).
+        vec3 position = vPosition[k] + vDirection[k] * (water - vRiver[k].x);
         fPosition = position;
         fNormal = vDirection[k];
         fRiver = vec4(vRiver[k].x, water, vRiver[k].z, vRiver[k].w);

@@ -18,10 +18,6 @@ layout(location = 7) flat out int vInstance;
 layout(location = 8) flat out int vSkirt;   // -1 surface, 0-3 edge skirts, 4-5 midline skirts
 layout(location = 9) flat out float vSpacing;
 
-const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
-const vec3 FACE_U[6] = vec3[](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0), vec3(1, 0, 0), vec3(1, 0, 0), vec3(-1, 0, 0));
-const vec3 FACE_V[6] = vec3[](vec3(0, 1, 0), vec3(0, 1, 0), vec3(0, 0, -1), vec3(0, 0, 1), vec3(0, 1, 0), vec3(0, 1, 0));
-
 // Texture coordinates of a grid position in the base-height texture, which has a border of HEIGHT_BORDER points
 // (planet::detail::BORDER) on each side.
 const float HEIGHT_BORDER = 2.0;
@@ -30,11 +26,18 @@ vec3 baseCoord(vec2 t) {
     return vec3((t + 0.5 + HEIGHT_BORDER) / (n + 2.0 * HEIGHT_BORDER), 0.0);
 }
 
-vec3 directionAt(PatchInstance p, vec2 grid) {
+// The unit direction at a grid position minus the patch centre's, to f32 precision relative to the patch's size
+// at any depth. With q = c + d (c: the centre on the cube, d: the offset within the patch on the cube),
+// q/|q| - c/|c| = d/|q| - c e / ((|c| + |q|) |q| |c|), where e = |q|^2 - |c|^2 = 2 c.d + d.d comes from per-patch
+// dot products; nothing subtracts two nearly equal large numbers.
+vec3 directionOffset(PatchInstance p, vec2 grid) {
     float n = frame.planet.y;
-    vec2 uv = p.uvRect.xy + grid / (n - 1.0) * p.uvRect.z;
-    int face = int(p.uvRect.w);
-    return normalize(FACE_NORMAL[face] + uv.x * FACE_U[face] + uv.y * FACE_V[face]);
+    vec2 st = grid / (n - 1.0) - 0.5;
+    vec3 d = st.x * p.axisU.xyz + st.y * p.axisV.xyz;
+    float e = st.x * p.axisU.w + st.y * p.axisV.w + dot(d, d);
+    float c = p.cubeCentre.w;
+    float q = sqrt(c * c + e);
+    return d / q - p.cubeCentre.xyz * (e / ((c + q) * q * c));
 }
 
 // The blended terrain height at a grid position (for normals: two texture reads).
@@ -61,10 +64,11 @@ vec4 surfaceAt(PatchInstance p, vec2 grid, out float baseHeight) {
     return vec4(height, max(river.z, frame.sun.w), river.w, halfWidth);
 }
 
-vec3 positionAt(PatchInstance p, vec2 grid, float height, vec3 direction) {
+// Camera-relative position: the patch centre relative to the camera (f64 on the CPU), plus the small offset of the
+// grid position on the sphere, plus the height along the direction.
+vec3 positionAt(PatchInstance p, float height, vec3 offset) {
     float radius = frame.planet.x;
-    // Relative to the patch centre first, so that no large coordinate reaches the rasteriser.
-    return p.centreRel.xyz + (direction - p.centreDir.xyz) * radius + direction * height;
+    return p.centreRel.xyz + p.centreDir.xyz * height + offset * (radius + height);
 }
 
 void main() {
@@ -86,10 +90,11 @@ void main() {
     vec2 grid = vec2(ij);
     float base;
     vec4 surface = surfaceAt(p, grid, base);
-    vec3 direction = directionAt(p, grid);
+    vec3 offset = directionOffset(p, grid);
+    vec3 direction = normalize(p.centreDir.xyz + offset);
     float height = surface.x;
     if (skirt) height -= frame.extra.x * p.centreDir.w;
-    vec3 position = positionAt(p, grid, height, direction);
+    vec3 position = positionAt(p, height, offset);
 
     // Normal from the four neighbours (clamped to the patch; the base texture's border keeps edges smooth). The
     // water pass needs none: water is level.
@@ -99,7 +104,7 @@ void main() {
         vec2 offsets[4] = vec2[](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1));
         for (int k = 0; k < 4; ++k) {
             vec2 g = clamp(grid + offsets[k], vec2(0.0), vec2(n - 1));
-            neighbour[k] = positionAt(p, g, heightAt(p, g), directionAt(p, g));
+            neighbour[k] = positionAt(p, heightAt(p, g), directionOffset(p, g));
         }
         normal = normalize(cross(neighbour[0] - neighbour[1], neighbour[2] - neighbour[3]));
         if (dot(normal, direction) < 0.0) normal = -normal;

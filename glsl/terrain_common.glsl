@@ -18,13 +18,17 @@ const uint WATER_AUTO = 0;
 const uint WATER_GEOMETRY = 1;
 const uint WATER_PAINTED = 2;
 
-// One drawn patch (or the part of an ancestor standing in for a patch whose data has not arrived).
+// One drawn patch (or the part of an ancestor standing in for a patch whose data has not arrived). Positions are
+// built relative to the camera from f64 values the CPU computed per patch, so precision does not depend on the
+// planet's size or the patch's depth (docs/rendering.md, "Precision").
 struct PatchInstance {
-    vec4 centreRel;  // xyz: radius * centre direction - camera; w: level
-    vec4 centreDir;  // xyz: unit centre direction; w: world distance between neighbouring vertices
-    vec4 uvRect;     // xy: face (u, v) of vertex (0, 0); z: (u, v) size; w: face
-    vec4 texRect;    // xy: source texel of vertex (0, 0); z: source texels per vertex; w: unused
-    ivec4 slots;     // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: unused
+    vec4 centreRel;   // xyz: radius * centre direction - camera (computed in f64); w: level
+    vec4 centreDir;   // xyz: unit centre direction; w: world distance between neighbouring vertices
+    vec4 cubeCentre;  // xyz: the patch centre on the cube; w: its length
+    vec4 axisU;       // xyz: cube-space step across the whole patch along i; w: 2 cubeCentre . axisU
+    vec4 axisV;       // xyz: the same along j; w: 2 cubeCentre . axisV
+    vec4 texRect;     // xy: source texel of vertex (0, 0); z: source texels per vertex; w: unused
+    ivec4 slots;      // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: unused
 };
 
 layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance instances[]; };

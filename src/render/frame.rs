@@ -23,7 +23,11 @@ use crate::{
         gpu::{create_river_texture, KernelBatch, KernelTuning, KernelVariant, RiverKernel},
         KernelParams, PatchJob, RiverSample,
     },
-    planet::{cube::PatchId, detail::PatchHeights, Planet},
+    planet::{
+        cube::{cube_point, PatchId, FACE_AXES},
+        detail::PatchHeights,
+        Planet,
+    },
     refine::{create_height_texture, with_ancestors, HeightRefiner, RefineJob},
     river::{
         network::RiverNetwork,
@@ -86,7 +90,9 @@ struct FramePush {
 pub struct PatchInstance {
     centre_rel: [f32; 4],
     centre_dir: [f32; 4],
-    uv_rect: [f32; 4],
+    cube_centre: [f32; 4],
+    axis_u: [f32; 4],
+    axis_v: [f32; 4],
     tex_rect: [f32; 4],
     slots: [i32; 4],
 }
@@ -781,7 +787,12 @@ fn instance(
     let p = selected.patch;
     let centre = p.center();
     let rel = centre * radius - camera;
-    let (u0, v0) = p.origin();
+    // The patch's frame on the cube, in f64: its centre and the steps across it (docs/rendering.md, "Precision").
+    let (_, a, b) = FACE_AXES[p.face as usize];
+    let (uc, vc) = p.uv(0.5, 0.5);
+    let cube_centre = cube_point(p.face as usize, uc, vc);
+    let (axis_u, axis_v) = (a * p.size(), b * p.size());
+    let with = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
     let depth = (p.level - source.level) as u32;
     let scale = 1.0 / (1u32 << depth) as f32;
     let offset_x = (p.x - (source.x << depth)) as f32 * scale * (n - 1) as f32;
@@ -795,7 +806,9 @@ fn instance(
             centre.z as f32,
             spacing as f32,
         ],
-        uv_rect: [u0 as f32, v0 as f32, p.size() as f32, p.face as f32],
+        cube_centre: with(cube_centre, cube_centre.length()),
+        axis_u: with(axis_u, 2.0 * cube_centre.dot(axis_u)),
+        axis_v: with(axis_v, 2.0 * cube_centre.dot(axis_v)),
         tex_rect: [offset_x, offset_y, scale, 0.0],
         slots: [
             data.base_slot.0 as i32,
