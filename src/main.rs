@@ -194,6 +194,10 @@ enum BenchCommand {
         /// The thesis's stress test: switch factor x10, camera x25.
         #[arg(long)]
         stress: bool,
+        /// Fly the descent from three radii out to two world units above the first river's water (the ground
+        /// preset) instead of the thesis's path.
+        #[arg(long, conflicts_with = "stress")]
+        descent: bool,
         #[arg(long, default_value_t = 300)]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).
@@ -476,6 +480,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             config,
             seed,
             stress,
+            descent,
             frames,
             speed,
             size,
@@ -499,6 +504,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 size,
                 compare_kernels: !no_kernel_comparison,
                 compare_water_modes: !no_water_comparison,
+                descent,
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {
@@ -516,7 +522,13 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 size[0],
                 size[1],
                 report.device,
-                if stress { " (stress)" } else { "" },
+                if stress {
+                    " (stress)"
+                } else if descent {
+                    " (descent)"
+                } else {
+                    ""
+                },
                 s.average_frame_ms,
                 s.average_fps,
                 s.median_frame_ms,
@@ -533,6 +545,16 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 s.max_resident_patches,
                 s.resident_patch_budget,
                 s.max_temporary_sample_bytes as f64 / 1e6
+            );
+            println!(
+                "  deepest level {}; peak memory {:.1} MB; frame ms median {:.1}, max after {} warm-up frames {:.1}; \
+                 at most {} patches made in a frame",
+                s.deepest_level,
+                s.peak_memory_bytes as f64 / 1e6,
+                s.frame_ms_median,
+                bench::flight::WARMUP_FRAMES,
+                s.frame_ms_max_after_warmup,
+                s.max_generated_patches
             );
             println!("  gpu ms per frame: {:?}", s.average_gpu_ms);
             println!("  cpu ms per frame: {:?}", s.average_cpu_ms);
@@ -697,7 +719,7 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     let config = load_config(&args.config)?;
     let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
-    if args.eye.length() <= config.planet.radius as f64 * 0.5 {
+    if args.preset.is_none() && args.eye.length() <= config.planet.radius as f64 * 0.5 {
         anyhow::bail!(
             "--eye {} is inside the planet (radius {})",
             args.eye,
@@ -768,10 +790,12 @@ fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
         .save(&args.out)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", args.out.display()))?;
     println!(
-        "{}: {w}x{h}, {frames} frames to stream the patches; last frame: {} visible patches, {} resident",
+        "{}: {w}x{h}, {frames} frames to stream the patches; last frame: {} visible patches, {} resident, \
+         deepest level {}",
         args.out.display(),
         stats.visible_patches,
-        stats.resident_patches
+        stats.resident_patches,
+        stats.deepest_level
     );
     for (pass, ms) in &stats.gpu_ms {
         println!("  gpu {pass:<8} {ms:8.3} ms");

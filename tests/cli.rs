@@ -144,3 +144,33 @@ fn bad_configuration_exits_with_2_and_names_the_element() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_ground_preset_reaches_deep_levels_made_on_demand() {
+    // Two units above the first river's water with max-level-of-detail 24: the patches under the camera are
+    // refined far beyond the precomputed level 4 (the thesis's precomputed pyramid stopped at 6).
+    let dir = temp_dir("ground");
+    let config = dir.join("deep.xml");
+    std::fs::write(
+        &config,
+        "<planet><rendering-attributes><max-level-of-detail>24</max-level-of-detail></rendering-attributes></planet>",
+    )
+    .unwrap();
+    let out = riverplanet()
+        .args(["render", "--seed", "1", "--preset", "ground", "--size", "160x90", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(dir.join("ground.png"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let deepest: u32 = stdout
+        .split("deepest level ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no deepest level in {stdout}"));
+    assert!(deepest >= 11, "deepest level {deepest}");
+    std::fs::remove_dir_all(&dir).ok();
+}

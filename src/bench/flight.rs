@@ -65,7 +65,24 @@ pub struct FlightSummary {
     pub kernel_ratios: BTreeMap<String, f64>,
     /// Average frame time of the same flight in each water mode.
     pub water_mode_frame_ms: BTreeMap<String, f64>,
+    /// The finest level drawn with its own data in any frame.
+    #[serde(default)]
+    pub deepest_level: u32,
+    /// Largest memory of any frame (patch textures, temporary data, precomputed heights), as `max_memory_bytes`.
+    #[serde(default)]
+    pub peak_memory_bytes: u64,
+    #[serde(default)]
+    pub frame_ms_median: f64,
+    /// Slowest frame after the first [`WARMUP_FRAMES`] (start-up: pipelines, the first patches).
+    #[serde(default)]
+    pub frame_ms_max_after_warmup: f64,
+    /// Patches made per frame (base heights refined or cut, river data computed), at most.
+    #[serde(default)]
+    pub max_generated_patches: usize,
 }
+
+/// Frames not counted in `frame_ms_max_after_warmup`.
+pub const WARMUP_FRAMES: usize = 10;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct FlightReport {
@@ -73,6 +90,7 @@ pub struct FlightReport {
     pub driver: String,
     pub threads: Threads,
     pub stress: bool,
+    pub descent: bool,
     pub seed: u32,
     pub resolution: [u32; 2],
     pub switch_factor: f32,
@@ -95,6 +113,8 @@ pub struct FlightOptions {
     pub compare_kernels: bool,
     /// Fly again in the geometry and painted water modes.
     pub compare_water_modes: bool,
+    /// Fly the descent to the ground instead of the thesis's path.
+    pub descent: bool,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -129,7 +149,14 @@ fn fly(
     renderer.capture_batches = runner.is_some();
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
-    let flight = Flight::new(world, options.frames, speed, w as f64 / h as f64);
+    let aspect = w as f64 / h as f64;
+    let flight = if options.descent {
+        Flight::descent(world, options.frames, aspect).ok_or_else(|| {
+            GpuError::Invalid("the descent needs a river, and this planet has none".into())
+        })?
+    } else {
+        Flight::new(world, options.frames, speed, aspect)
+    };
     let mut frames = Vec::with_capacity(options.frames as usize);
     let mut layout = vk::ImageLayout::UNDEFINED;
     let result = (|| {
@@ -235,10 +262,20 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
             avg("cpu_single") / avg("cpu_rayon"),
         );
     }
+    let max_memory_bytes = stats.iter().map(|s| s.memory_bytes).max().unwrap_or(0);
     FlightSummary {
         frames: frames.len(),
         average_frame_ms,
         median_frame_ms: super::median(&frame_ms),
+        deepest_level: stats.iter().map(|s| s.deepest_level).max().unwrap_or(0),
+        peak_memory_bytes: max_memory_bytes,
+        frame_ms_median: super::median(&frame_ms),
+        frame_ms_max_after_warmup: frame_ms
+            .iter()
+            .skip(WARMUP_FRAMES)
+            .copied()
+            .fold(0.0, f64::max),
+        max_generated_patches: stats.iter().map(|s| s.new_patches).max().unwrap_or(0),
         max_frame_ms: frame_ms.iter().copied().fold(0.0, f64::max),
         average_fps: if average_frame_ms > 0.0 {
             1000.0 / average_frame_ms
@@ -251,7 +288,7 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
         max_new_patches: stats.iter().map(|s| s.new_patches).max().unwrap_or(0),
         average_samples: mean(stats.iter().map(|s| s.samples as f64)),
         max_samples: stats.iter().map(|s| s.samples).max().unwrap_or(0),
-        max_memory_bytes: stats.iter().map(|s| s.memory_bytes).max().unwrap_or(0),
+        max_memory_bytes,
         max_patch_texture_bytes: stats
             .iter()
             .map(|s| s.patch_texture_bytes)
@@ -330,6 +367,7 @@ pub fn flight_bench(
         driver: format!("{} {}", ctx.adapter.driver_name, ctx.adapter.driver_info),
         threads: Threads::current(),
         stress: options.stress,
+        descent: options.descent,
         seed: world.seed,
         resolution: options.size,
         switch_factor: config.rendering.level_of_detail_switch_factor,

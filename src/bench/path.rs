@@ -1,14 +1,18 @@
-//! The scripted camera of the experiments (Section 9.2): from orbit down to a river, then low along it towards the
+//! The scripted cameras of the experiments (Section 9.2): from orbit down to a river, then low along it towards the
 //! sea. The stress test (9.2) moves the camera 25 times faster: the descent is over after a 25th of the frames and
-//! the low flight covers 25 times the distance.
+//! the low flight covers 25 times the distance. Beyond the thesis, the descent to the ground: from three radii
+//! out straight down to the ground preset (two world units above the first river's water), for the deepest levels
+//! of detail.
 
 use glam::DVec3;
 
-use crate::{runtime::camera::Camera, world::World};
+use crate::{render::presets::GROUND_EYE_HEIGHT, runtime::camera::Camera, world::World};
 
 /// A flight of `frames` frames over `world`.
 #[derive(Clone, Debug)]
 pub struct Flight {
+    /// The descent to the ground: (eye at the end, look-at at the end); `None` for the thesis's flight.
+    ground: Option<(DVec3, DVec3)>,
     start: DVec3,
     end: DVec3,
     radius: f64,
@@ -31,6 +35,7 @@ impl Flight {
             None => (DVec3::Z, DVec3::new(0.3, 0.0, 1.0).normalize()),
         };
         Self {
+            ground: None,
             start,
             end,
             radius: world.planet.radius,
@@ -40,8 +45,21 @@ impl Flight {
         }
     }
 
+    /// The descent to the ground preset in `frames` frames (`None` when the planet has no river): the altitude
+    /// falls geometrically from two radii (three from the centre) to the preset's eye, and the view turns from
+    /// the planet's centre to the preset's target.
+    pub fn descent(world: &World, frames: u32, aspect: f64) -> Option<Self> {
+        let ground = crate::render::presets::camera(crate::render::presets::Preset::Ground, world)?;
+        let mut flight = Self::new(world, frames, 1.0, aspect);
+        flight.ground = Some(ground);
+        Some(flight)
+    }
+
     /// The camera at `frame`.
     pub fn camera(&self, world: &World, frame: u32) -> Camera {
+        if let Some((eye, target)) = self.ground {
+            return self.descent_camera(eye, target, frame);
+        }
         let s = frame as f64 / self.frames as f64 * self.speed;
         let descent = (s / DESCENT).min(1.0);
         // Along the great circle from the source towards the mouth (and beyond, for long flights).
@@ -69,6 +87,22 @@ impl Flight {
         Camera::look_at(
             eye,
             target,
+            60.0,
+            self.aspect,
+            (altitude * 0.05).clamp(0.01, 10.0),
+        )
+    }
+
+    fn descent_camera(&self, end: DVec3, target: DVec3, frame: u32) -> Camera {
+        let s = (frame as f64 / (self.frames - 1).max(1) as f64).min(1.0);
+        let ground = end.length() - GROUND_EYE_HEIGHT;
+        let high = 3.0 * self.radius - ground;
+        let altitude = high * (GROUND_EYE_HEIGHT / high).powf(s);
+        let eye = end.normalize() * (ground + altitude);
+        let look = DVec3::ZERO.lerp(target, s.powf(0.25));
+        Camera::look_at(
+            eye,
+            look,
             60.0,
             self.aspect,
             (altitude * 0.05).clamp(0.01, 10.0),

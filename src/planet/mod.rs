@@ -312,6 +312,12 @@ impl Planet {
         bottom * (1.0 - fy) + top * fy
     }
 
+    /// The height of the visible surface (terrain or sea) above the sphere at a unit direction, on the
+    /// precomputed lattice: where the level of detail measures distances from.
+    pub fn surface_height(&self, direction: DVec3) -> f64 {
+        self.height_at(direction).max(self.sea_level) as f64
+    }
+
     /// Whether a direction is land on the base terrain (above sea level).
     pub fn is_land(&self, direction: DVec3) -> bool {
         self.height_at(direction) > self.sea_level

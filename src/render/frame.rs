@@ -37,7 +37,7 @@ use crate::{
         cache::{PatchCache, PatchData},
         camera::Camera,
         cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
-        lod::{select, LodParams, Selected},
+        lod::{select_over, LodParams, Selected},
     },
     shaders,
 };
@@ -111,6 +111,8 @@ pub struct FrameStats {
     pub fallback_patches: usize,
     /// Patches still waiting for data after this frame.
     pub pending_patches: usize,
+    /// The finest level drawn with its own data.
+    pub deepest_level: u32,
     pub samples: usize,
     pub resident_patches: usize,
     pub evicted_patches: usize,
@@ -297,7 +299,9 @@ impl<'w> Renderer<'w> {
         let t = Instant::now();
         let selected = match (&self.frozen, self.freeze_lod) {
             (Some(frozen), true) => frozen.clone(),
-            _ => select(camera.position, &self.lod_params()),
+            _ => select_over(camera.position, &self.lod_params(), &|d| {
+                self.planet.surface_height(d)
+            }),
         };
         self.frozen = Some(selected.clone());
         cpu.insert("lod".to_string(), ms_since(t));
@@ -401,6 +405,7 @@ impl<'w> Renderer<'w> {
         let mut drawn: Vec<(PatchInstance, bool)> = Vec::with_capacity(visible.len());
         for s in &visible {
             let source = if self.cache.contains(&s.patch) {
+                stats.deepest_level = stats.deepest_level.max(s.patch.level as u32);
                 s.patch
             } else {
                 stats.fallback_patches += 1;

@@ -13,7 +13,13 @@ pub enum Preset {
     Mountains,
     /// Close above the first river's middle, looking along it.
     River,
+    /// Two world units (metres in config/earth.xml) above the first river's water at its middle, looking
+    /// downstream along it: the deepest levels of detail.
+    Ground,
 }
+
+/// Height of the ground preset's eye above the river's water, in world units.
+pub const GROUND_EYE_HEIGHT: f64 = 2.0;
 
 /// (eye, look-at) for `preset`, or `None` when the planet has no river.
 pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
@@ -52,6 +58,17 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
                 eye_dir * (r + height(eye_dir).max(0.4) + 25.0),
                 target * (r + height(target)),
             )
+        }
+        Preset::Ground => {
+            let segment = &system.segments[system.segments.len() / 2];
+            let middle = segment.curve.point(0.5);
+            let water = segment.height_at(0.5) as f64;
+            let here = up(system.frame.to_sphere(middle));
+            // Look at the water 25 eye heights downstream.
+            let ahead =
+                middle + segment.curve.derivative(0.5).normalize() * 25.0 * GROUND_EYE_HEIGHT;
+            let ahead = up(system.frame.to_sphere(ahead));
+            (here * (r + water + GROUND_EYE_HEIGHT), ahead * (r + water))
         }
     })
 }
