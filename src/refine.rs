@@ -159,11 +159,19 @@ impl HeightRefiner {
         self.pipeline.destroy(ctx);
         self.jobs_layout.destroy(ctx);
     }
+}
 
-    /// Vertices per patch edge this pipeline was built for.
-    pub fn vertices(&self) -> u32 {
-        self.vertices
-    }
+/// Moves fresh base-height textures to GENERAL, ready for uploads and for the refinement shader's writes.
+pub fn prepare_height_textures(rec: &mut Recorder, images: &[&Image]) {
+    rec.image_transitions(
+        images,
+        vk::ImageLayout::UNDEFINED,
+        vk::ImageLayout::GENERAL,
+        vk::PipelineStageFlags2::NONE,
+        vk::AccessFlags2::NONE,
+        vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
+        vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+    );
 }
 
 /// Creates one patch's base-height texture: `(n + 2 BORDER)^2` texels, written by upload (precomputed levels)
@@ -278,15 +286,7 @@ pub fn generate_on_gpu(
     let bindless_ref = &*bindless;
     let result = ctx.run_and_wait("height refinement", |rec| {
         let refs: Vec<&Image> = images.iter().collect();
-        rec.image_transitions(
-            &refs,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
-            vk::PipelineStageFlags2::NONE,
-            vk::AccessFlags2::NONE,
-            vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        );
+        prepare_height_textures(rec, &refs);
         let mut jobs = Vec::new();
         for (p, image) in all.iter().zip(&images) {
             if p.level as u32 <= planet.precomputed_level {

@@ -157,14 +157,20 @@ fn the_ground_preset_reaches_deep_levels_made_on_demand() {
     )
     .unwrap();
     let out = riverplanet()
-        .args(["render", "--seed", "1", "--preset", "ground", "--size", "160x90", "--config"])
+        .args([
+            "render", "--seed", "1", "--preset", "ground", "--size", "160x90", "--config",
+        ])
         .arg(&config)
         .arg("--out")
         .arg(dir.join("ground.png"))
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let deepest: u32 = stdout
         .split("deepest level ")
         .nth(1)

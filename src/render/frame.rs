@@ -28,7 +28,9 @@ use crate::{
         detail::PatchHeights,
         Planet,
     },
-    refine::{create_height_texture, with_ancestors, HeightRefiner, RefineJob},
+    refine::{
+        create_height_texture, prepare_height_textures, with_ancestors, HeightRefiner, RefineJob,
+    },
     river::{
         network::RiverNetwork,
         samples::{patch_samples, PatchFrame},
@@ -610,17 +612,10 @@ impl<'w> Renderer<'w> {
             bases.push((image, slot));
         }
         let base_refs: Vec<&Image> = bases.iter().map(|(i, _)| i).collect();
-        rec.image_transitions(
-            &base_refs,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
-            vk::PipelineStageFlags2::NONE,
-            vk::AccessFlags2::NONE,
-            vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        );
-        // Lowest height of each new patch (border included): exact for uploaded ones, a bound for refined ones.
-        let mut min_heights: HashMap<PatchId, f32> = HashMap::new();
+        prepare_height_textures(rec, &base_refs);
+        // Slot and lowest height (border included) of each new patch: exact for uploaded ones, a bound for
+        // refined ones.
+        let mut made: HashMap<PatchId, (Slot, f32)> = HashMap::new();
         let mut jobs: Vec<RefineJob> = Vec::new();
         for (p, (image, slot)) in prepared.iter().zip(&bases) {
             let min_height = match &p.heights {
@@ -635,8 +630,8 @@ impl<'w> Renderer<'w> {
                 }
                 None => {
                     let parent = p.patch.parent().expect("refined patches have parents");
-                    let (parent_slot, parent_min) = match min_heights.get(&parent) {
-                        Some(&m) => (jobs_slot(prepared, &bases, parent), m),
+                    let (parent_slot, parent_min) = match made.get(&parent) {
+                        Some(&made) => made,
                         None => {
                             let data = self.cache.touch(&parent).ok_or_else(|| {
                                 GpuError::Invalid(format!("{:?} has no resident parent", p.patch))
@@ -652,7 +647,7 @@ impl<'w> Renderer<'w> {
                     parent_min - self.planet.rule.remaining_range(p.patch.level as u32 - 1)
                 }
             };
-            min_heights.insert(p.patch, min_height);
+            made.insert(p.patch, (*slot, min_height));
         }
         rec.memory_barrier(
             vk::PipelineStageFlags2::COPY,
@@ -724,7 +719,7 @@ impl<'w> Renderer<'w> {
             let river = river.and_then(|k| rivers[k].take());
             self.cache.insert(
                 p.patch,
-                PatchData::new(base, slot, river, p.samples.len(), min_heights[&p.patch]),
+                PatchData::new(base, slot, river, p.samples.len(), made[&p.patch].1),
             );
         }
         Ok((bytes, river_count))
@@ -769,15 +764,6 @@ struct NewPatch {
     patch: PatchId,
     heights: Option<PatchHeights>,
     samples: Vec<RiverSample>,
-}
-
-/// The slot of `patch`'s new base texture among this frame's new patches.
-fn jobs_slot(prepared: &[NewPatch], bases: &[(Image, Slot)], patch: PatchId) -> Slot {
-    let index = prepared
-        .iter()
-        .position(|p| p.patch == patch)
-        .expect("a parent made this frame comes before its children");
-    bases[index].1
 }
 
 /// The instance that draws `selected` from `source`'s textures (itself, or an ancestor standing in).
