@@ -22,9 +22,13 @@ struct RefineJob {
     int face;
     int level;      // the child's
     ivec2 patchXY;  // the child's position in its level's grid
-    ivec2 unused;
+    int rangeIndex; // where the child's lowest and highest height go in `ranges`
+    int unused;
 };
 layout(set = 1, binding = 0, std430) readonly buffer Jobs { RefineJob jobs[]; };
+// Lowest and highest height of every refined patch (border included), read back by the renderer for its level of
+// detail and culling bounds.
+layout(set = 1, binding = 1, std430) writeonly buffer Ranges { vec2 ranges[]; };
 
 layout(push_constant) uniform Push {
     uint seed;
@@ -32,6 +36,7 @@ layout(push_constant) uniform Push {
 } push;
 
 shared float centres[SPAN * SPAN];
+shared vec2 laneRanges[64];
 
 const ivec3 FACE_NORMAL[6] = ivec3[](ivec3(1, 0, 0), ivec3(-1, 0, 0), ivec3(0, 1, 0), ivec3(0, -1, 0), ivec3(0, 0, 1), ivec3(0, 0, -1));
 const ivec3 FACE_U[6] = ivec3[](ivec3(0, 0, -1), ivec3(0, 0, 1), ivec3(1, 0, 0), ivec3(1, 0, 0), ivec3(1, 0, 0), ivec3(-1, 0, 0));
@@ -133,6 +138,7 @@ void main() {
     barrier();
 
     // Every stored point: the parent's, a centre, or the square step of an edge midpoint.
+    vec2 range = vec2(3.4e38, -3.4e38);
     for (uint k = lane; k < SIDE * SIDE; k += gl_WorkGroupSize.x) {
         ivec2 texel = ivec2(k % SIDE, k / SIDE);
         ivec2 g = origin + texel - BORDER;
@@ -147,5 +153,18 @@ void main() {
             value = displaced(sortedAverage(around), g);
         }
         imageStore(heightImages[nonuniformEXT(job.childSlot)], ivec3(texel, 0), vec4(value));
+        range = vec2(min(range.x, value), max(range.y, value));
     }
+
+    // The patch's height range: a tree reduction over the workgroup.
+    laneRanges[lane] = range;
+    barrier();
+    for (uint stride = gl_WorkGroupSize.x / 2; stride > 0; stride /= 2) {
+        if (lane < stride) {
+            vec2 other = laneRanges[lane + stride];
+            laneRanges[lane] = vec2(min(laneRanges[lane].x, other.x), max(laneRanges[lane].y, other.y));
+        }
+        barrier();
+    }
+    if (lane == 0) ranges[job.rangeIndex] = laneRanges[0];
 }

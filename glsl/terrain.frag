@@ -39,10 +39,11 @@ const vec3 SNOW = vec3(0.93, 0.94, 0.97);
 const vec3 WATER_SHALLOW = vec3(0.12, 0.42, 0.55);
 const vec3 WATER_DEEP = vec3(0.02, 0.10, 0.28);
 
-// Fig. 8.2: weights of the textures by height, with linear transitions.
+// Fig. 8.2: weights of the textures by height, with linear transitions; heights in units of frame.extra.z, so
+// that the bands keep their place relative to the mountains on any planet.
 vec3 terrainColour(float height, float slope, vec3 detail) {
     float sea = frame.sun.w;
-    float h = height - sea;
+    float h = (height - sea) / frame.extra.z;
     vec3 c = mix(SAND, DIRT, smoothstep(0.0, 0.6, h));
     c = mix(c, GRASS, smoothstep(0.4, 1.4, h));
     c = mix(c, ROCK, smoothstep(6.0, 9.0, h));
@@ -67,13 +68,13 @@ void main() {
         // River water covers the basin only: a triangle reaching past the banks is cut at the river's width.
         if (fRiverWater == 1 && abs(fRiver.z) > fRiver.w) discard;
         float depth = max(fRiver.y - fRiver.x, 0.0);
-        vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / 4.0, 0.0, 1.0));
+        vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
         float diffuse = max(dot(up, sun), 0.0);
         vec3 reflected = reflect(-sun, up);
         float specular = pow(max(dot(reflected, view), 0.0), 80.0) * step(0.0, dot(up, sun));
         float fresnel = 0.02 + 0.98 * pow(1.0 - max(dot(up, view), 0.0), 5.0);
         colour = colour * (0.25 + 0.75 * diffuse) + vec3(1.0, 0.95, 0.85) * specular * 0.8 + vec3(0.5, 0.6, 0.7) * fresnel * 0.3;
-        float alpha = clamp(0.55 + depth * 0.3, 0.55, 0.92);
+        float alpha = clamp(0.55 + depth / frame.extra.z * 0.3, 0.55, 0.92);
         outColor = vec4(colour, alpha);
         return;
     }

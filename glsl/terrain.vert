@@ -40,28 +40,52 @@ vec3 directionOffset(PatchInstance p, vec2 grid) {
     return d / q - p.cubeCentre.xyz * (e / ((c + q) * q * c));
 }
 
-// The blended terrain height at a grid position (for normals: two texture reads).
-float heightAt(PatchInstance p, vec2 grid) {
-    float n = frame.planet.y;
+float baseAt(PatchInstance p, vec2 grid) {
     vec2 t = p.texRect.xy + grid * p.texRect.z;
-    float base = textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
+    return textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
+}
+
+// River data at a grid position (layer 0: terrain height, lerp factor, water height, signed distance; and the
+// half width), blended by the morph factor into the parent's river data at the same place.
+vec4 riverAt(PatchInstance p, vec2 grid, float morph, out float halfWidth) {
+    float n = frame.planet.y;
+    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, 0.0);
+    vec4 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
+    halfWidth = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv + vec3(0, 0, 1), 0.0).r;
+    if (morph > 0.0 && p.slots.w >= 0) {
+        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, 0.0);
+        river = mix(river, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
+        halfWidth = mix(halfWidth, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv + vec3(0, 0, 1), 0.0).r,
+                        morph);
+    }
+    return river;
+}
+
+// The blended terrain height at a grid position (for normals).
+float heightAt(PatchInstance p, vec2 grid, float morph) {
+    float base = baseAt(p, grid);
     if (p.slots.y < 0) return base;
-    vec2 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3((t + 0.5) / n, 0.0), 0.0).xy;
+    float halfWidth;
+    vec4 river = riverAt(p, grid, morph, halfWidth);
     return mix(river.x, base, river.y);
 }
 
-// River data and base height at a grid position, read from the patch's (or its stand-in's) textures.
-vec4 surfaceAt(PatchInstance p, vec2 grid, out float baseHeight) {
-    float n = frame.planet.y;
-    vec2 t = p.texRect.xy + grid * p.texRect.z;
-    baseHeight = textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
-    if (p.slots.y < 0) return vec4(baseHeight, frame.sun.w, 1e9, 0.0);
-    vec2 uv = (t + 0.5) / n;
-    vec4 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3(uv, 0.0), 0.0);
-    float halfWidth = textureLod(patchTextures[nonuniformEXT(p.slots.y)], vec3(uv, 1.0), 0.0).r;
+// Terrain height, water height, signed distance and half width at a grid position, from the patch's (or its
+// stand-in's) textures.
+vec4 surfaceAt(PatchInstance p, vec2 grid, float morph) {
+    float base = baseAt(p, grid);
+    if (p.slots.y < 0) return vec4(base, frame.sun.w, 1e9, 0.0);
+    float halfWidth;
+    vec4 river = riverAt(p, grid, morph, halfWidth);
     // Section 8.2: blend the river terrain into the base terrain by the lerp factor.
-    float height = mix(river.x, baseHeight, river.y);
+    float height = mix(river.x, base, river.y);
     return vec4(height, max(river.z, frame.sun.w), river.w, halfWidth);
+}
+
+// Beyond the thesis (CDLOD, Strugar 2009): how far a vertex has morphed towards its parent's mesh, from its
+// distance to the camera: 0 inside the morph band's start, 1 from the patch level's switch distance on.
+float morphFactor(PatchInstance p, float distance) {
+    return clamp((distance - p.morph.x) * p.morph.y, 0.0, 1.0);
 }
 
 // Camera-relative position: the patch centre relative to the camera (f64 on the CPU), plus the small offset of the
@@ -88,23 +112,28 @@ void main() {
         ij = along[edge];
     }
     vec2 grid = vec2(ij);
-    float base;
-    vec4 surface = surfaceAt(p, grid, base);
-    vec3 offset = directionOffset(p, grid);
+    // Morph: odd grid coordinates slide towards the even neighbour below, so that fully morphed the mesh is the
+    // parent's (whose points keep their heights at every level); the distance is the unmorphed vertex's, from its
+    // base height, which neighbouring patches share bit for bit.
+    float morph = morphFactor(p, length(positionAt(p, baseAt(p, grid), directionOffset(p, grid))));
+    vec2 morphed = grid - mod(grid, 2.0) * morph;
+    vec4 surface = surfaceAt(p, morphed, morph);
+    vec3 offset = directionOffset(p, morphed);
     vec3 direction = normalize(p.centreDir.xyz + offset);
     float height = surface.x;
     if (skirt) height -= frame.extra.x * p.centreDir.w;
     vec3 position = positionAt(p, height, offset);
 
-    // Normal from the four neighbours (clamped to the patch; the base texture's border keeps edges smooth). The
-    // water pass needs none: water is level.
+    // Normal from the four neighbours (one parent spacing apart when fully morphed); at the patch edges the
+    // neighbour outside is the base texture's border point (the neighbouring patch's vertex, same bits), so both
+    // sides of a seam get the same normal. The water pass needs none: water is level.
     vec3 normal = direction;
     if (WATER_PASS == 0) {
         vec3 neighbour[4];
         vec2 offsets[4] = vec2[](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1));
         for (int k = 0; k < 4; ++k) {
-            vec2 g = clamp(grid + offsets[k], vec2(0.0), vec2(n - 1));
-            neighbour[k] = positionAt(p, heightAt(p, g), directionOffset(p, g));
+            vec2 g = morphed + offsets[k] * (1.0 + morph);
+            neighbour[k] = positionAt(p, heightAt(p, g, morph), directionOffset(p, g));
         }
         normal = normalize(cross(neighbour[0] - neighbour[1], neighbour[2] - neighbour[3]));
         if (dot(normal, direction) < 0.0) normal = -normal;

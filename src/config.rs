@@ -87,6 +87,10 @@ pub struct RiverConfig {
     pub max_attempts: u32,
     /// Samples per half river width (6.4: "three sample points for every distance half the width").
     pub samples_per_half_width: u32,
+    /// Beyond the thesis: samples at most this many per vertex spacing along a river (0: no limit, the thesis's
+    /// rule). On a planet whose rivers are many orders of magnitude narrower than a coarse patch, the thesis's
+    /// rule gives a coarse patch millions of samples for detail its vertices cannot show.
+    pub samples_per_vertex_spacing: u32,
 }
 
 /// `<rendering-attributes>`: Table 6.1 plus the run-time budgets.
@@ -143,6 +147,7 @@ impl Default for Config {
                 displacement: 0.3,
                 max_attempts: 16,
                 samples_per_half_width: 3,
+                samples_per_vertex_spacing: 0,
             },
             rendering: RenderingConfig {
                 vertices: 33,
@@ -201,6 +206,7 @@ struct RawRiver {
     displacement: Option<String>,
     max_attempts: Option<String>,
     samples_per_half_width: Option<String>,
+    samples_per_vertex_spacing: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -530,6 +536,13 @@ impl Config {
                 dv.samples_per_half_width,
                 1,
                 16,
+            )?,
+            samples_per_vertex_spacing: r.u32(
+                "samples-per-vertex-spacing",
+                &v.samples_per_vertex_spacing,
+                dv.samples_per_vertex_spacing,
+                0,
+                64,
             )?,
         };
         let widest = river.starting_width * river.ending_factor.max(1.0);

@@ -29,7 +29,8 @@ struct GpuRefineJob {
     level: i32,
     x: i32,
     y: i32,
-    unused: [i32; 2],
+    range_index: i32,
+    unused: i32,
 }
 
 #[repr(C)]
@@ -47,6 +48,38 @@ pub struct RefineJob {
     pub parent_slot: Slot,
 }
 
+/// A patch's lowest and highest base height.
+pub type HeightRange = (f32, f32);
+
+/// The height ranges of one recording's refined patches, in a host-visible buffer the shader writes.
+pub struct RefinedRanges {
+    patches: Vec<PatchId>,
+    buffer: crate::gpu::Buffer,
+    /// Bytes of the job tables and this buffer (the frame's temporary memory).
+    pub bytes: u64,
+}
+
+impl RefinedRanges {
+    /// Each refined patch's lowest and highest height (border included), once the submission has completed; the
+    /// buffer is freed.
+    pub fn read(self, ctx: &Context) -> Result<Vec<(PatchId, HeightRange)>, GpuError> {
+        let ranges = self
+            .buffer
+            .mapped()
+            .map(|bytes| {
+                bytemuck::cast_slice::<u8, [f32; 2]>(&bytes[..self.patches.len() * 8]).to_vec()
+            })
+            .ok_or_else(|| GpuError::Invalid("height range buffer is not host-visible".into()));
+        ctx.retire_buffer(self.buffer);
+        Ok(self
+            .patches
+            .into_iter()
+            .zip(ranges?)
+            .map(|(p, [lo, hi])| (p, (lo, hi)))
+            .collect())
+    }
+}
+
 /// The refinement pipeline.
 pub struct HeightRefiner {
     pipeline: ComputePipeline,
@@ -56,7 +89,7 @@ pub struct HeightRefiner {
 
 impl HeightRefiner {
     pub fn new(ctx: &Context, bindless: &Bindless, vertices: u32) -> Result<Self, GpuError> {
-        let jobs_layout = BufferSetLayout::new(ctx, 1, "height refinement jobs")?;
+        let jobs_layout = BufferSetLayout::new(ctx, 2, "height refinement jobs and ranges")?;
         let pipeline = ComputePipeline::new(
             ctx,
             shaders::HEIGHTS_REFINE_COMP,
@@ -82,30 +115,33 @@ impl HeightRefiner {
     /// Records the refinement of `jobs`, sorted by level, each child's parent resident or earlier in the list:
     /// one dispatch per level (a workgroup per patch), with a barrier between levels so that a child reads its
     /// parent's finished heights. The children's textures must be in GENERAL, bound at their slots; the caller
-    /// makes the results visible to whatever reads them next. Returns the job table's size in bytes.
+    /// makes the results visible to whatever reads them next. Returns where each child's height range arrives
+    /// (read it once the submission has completed), or `None` without jobs.
     pub fn record(
         &self,
         rec: &mut Recorder,
         bindless: &Bindless,
         planet: &Planet,
         jobs: &[RefineJob],
-    ) -> Result<u64, GpuError> {
+    ) -> Result<Option<RefinedRanges>, GpuError> {
         if jobs.is_empty() {
-            return Ok(0);
+            return Ok(None);
         }
         debug_assert!(jobs
             .windows(2)
             .all(|w| w[0].patch.level <= w[1].patch.level));
         let table: Vec<GpuRefineJob> = jobs
             .iter()
-            .map(|j| GpuRefineJob {
+            .enumerate()
+            .map(|(k, j)| GpuRefineJob {
                 child_slot: j.slot.0 as i32,
                 parent_slot: j.parent_slot.0 as i32,
                 face: j.patch.face as i32,
                 level: j.patch.level as i32,
                 x: j.patch.x as i32,
                 y: j.patch.y as i32,
-                unused: [0; 2],
+                range_index: k as i32,
+                unused: 0,
             })
             .collect();
         let push = RefinePush {
@@ -114,8 +150,18 @@ impl HeightRefiner {
         };
         let push = bytemuck::bytes_of(&push);
         let row = std::mem::size_of::<GpuRefineJob>();
+        let ranges = rec.ctx().create_buffer(&BufferDesc {
+            name: "refined height ranges",
+            size: (jobs.len() * 8) as u64,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        let mut out = RefinedRanges {
+            patches: jobs.iter().map(|j| j.patch).collect(),
+            bytes: ranges.size,
+            buffer: ranges,
+        };
         let mut start = 0;
-        let mut bytes = 0;
         while start < jobs.len() {
             let level = jobs[start].patch.level;
             let end = start
@@ -138,8 +184,8 @@ impl HeightRefiner {
                 location: MemoryLocation::CpuToGpu,
             })?;
             buffer.write(0, &table[start..end])?;
-            bytes += buffer.size;
-            let set = rec.buffer_set(&self.jobs_layout, &[&buffer]);
+            out.bytes += buffer.size;
+            let set = rec.buffer_set(&self.jobs_layout, &[&buffer, &out.buffer]);
             if let Ok(set) = set {
                 rec.dispatch(
                     &self.pipeline,
@@ -152,7 +198,14 @@ impl HeightRefiner {
             set?;
             start = end;
         }
-        Ok(bytes)
+        rec.buffer_barrier(
+            &out.buffer,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+        Ok(Some(out))
     }
 
     pub fn destroy(self, ctx: &Context) {
@@ -226,6 +279,14 @@ pub fn with_ancestors(
     out
 }
 
+/// What [`generate_on_gpu`] read back.
+pub struct GpuPatches {
+    /// The requested patches' heights, in request order.
+    pub heights: Vec<PatchHeights>,
+    /// The height range the shader reported for every refined patch (requested or ancestor).
+    pub ranges: HashMap<PatchId, HeightRange>,
+}
+
 /// Makes `patches` and every ancestor they need on the GPU (the precomputed ones uploaded from the planet's
 /// lattice, the rest refined level by level) and reads their heights back. For tests and tools: the renderer
 /// records the same work into its frames.
@@ -235,7 +296,7 @@ pub fn generate_on_gpu(
     refiner: &HeightRefiner,
     planet: &Planet,
     patches: &[PatchId],
-) -> Result<Vec<PatchHeights>, GpuError> {
+) -> Result<GpuPatches, GpuError> {
     let n = refiner.vertices;
     let all = with_ancestors(patches, planet.precomputed_level, |_| false);
     let mut images: Vec<Image> = Vec::with_capacity(all.len());
@@ -312,7 +373,7 @@ pub fn generate_on_gpu(
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::AccessFlags2::SHADER_SAMPLED_READ,
         );
-        refiner.record(rec, bindless_ref, planet, &jobs)?;
+        let ranges = refiner.record(rec, bindless_ref, planet, &jobs)?;
         rec.memory_barrier(
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
@@ -338,13 +399,17 @@ pub fn generate_on_gpu(
             vk::PipelineStageFlags2::HOST,
             vk::AccessFlags2::HOST_READ,
         );
-        Ok(())
+        Ok(ranges)
     });
-    let out = result.and_then(|()| {
+    let out = result.and_then(|ranges| {
+        let ranges = match ranges {
+            Some(r) => r.read(ctx)?.into_iter().collect(),
+            None => HashMap::new(),
+        };
         let bytes = readback
             .mapped()
             .ok_or_else(|| GpuError::Invalid("readback buffer is not host-visible".into()))?;
-        Ok(patches
+        let heights = patches
             .iter()
             .enumerate()
             .map(|(k, p)| {
@@ -357,7 +422,8 @@ pub fn generate_on_gpu(
                     data: texels.to_vec(),
                 }
             })
-            .collect())
+            .collect();
+        Ok(GpuPatches { heights, ranges })
     });
     ctx.retire_buffer(readback);
     release(images, slots, bindless);

@@ -195,7 +195,8 @@ fn gpu_refinement_equals_the_cpu_reference_bit_for_bit() {
     let refiner = HeightRefiner::new(ctx, &bindless, planet.vertices).unwrap();
     for level in [6u8, 12, 20] {
         let wanted = corner_and_edge_patches(level);
-        let gpu = generate_on_gpu(ctx, &mut bindless, &refiner, &planet, &wanted).unwrap();
+        let made = generate_on_gpu(ctx, &mut bindless, &refiner, &planet, &wanted).unwrap();
+        let gpu = made.heights;
         for g in &gpu {
             let cpu = planet.patch_heights(g.patch);
             let differing = g
@@ -209,6 +210,8 @@ fn gpu_refinement_equals_the_cpu_reference_bit_for_bit() {
                 "{:?}: {differing} texels differ from the CPU reference",
                 g.patch
             );
+            // The range the shader reduces (for the renderer's bounds) is the texture's.
+            assert_eq!(made.ranges[&g.patch], cpu.range(), "{:?}", g.patch);
         }
         let shared = assert_seams_agree(&planet, &gpu);
         assert!(shared > 0, "level {level}");

@@ -27,38 +27,7 @@ fn world() -> &'static World {
 
 /// Renders until every visible patch has its own data, and returns the image.
 fn render(ctx: &Context, camera: &Camera, size: [u32; 2], water: WaterMode) -> image::RgbaImage {
-    let world = world();
-    let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &world.config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
-    renderer.water_mode = water;
-    let mut layout = vk::ImageLayout::UNDEFINED;
-    for _ in 0..100 {
-        let stats = renderer
-            .render(
-                camera,
-                &target.target(CLEAR),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )
-            .unwrap();
-        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-        if stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0 {
-            break;
-        }
-    }
-    let image = target.read(ctx).unwrap();
-    renderer.destroy();
-    target.destroy(ctx);
-    image
+    render_with(ctx, camera, size, |renderer| renderer.water_mode = water)
 }
 
 fn preset_camera(preset: Preset, aspect: f64) -> Camera {
@@ -217,4 +186,45 @@ fn no_pixel_inside_the_planet_shows_the_clear_colour() {
         assert!(inside > 0, "camera {k} sees no planet");
     }
     common::assert_no_validation_errors(ctx);
+}
+
+/// Renders with the renderer configured by `setup`, until every visible patch has its own data.
+fn render_with(
+    ctx: &Context,
+    camera: &Camera,
+    size: [u32; 2],
+    setup: impl Fn(&mut Renderer),
+) -> image::RgbaImage {
+    let world = world();
+    let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
+    let mut renderer = Renderer::new(
+        ctx,
+        &world.planet,
+        &world.network,
+        &world.config,
+        COLOR_FORMAT,
+        DEPTH_FORMAT,
+    )
+    .unwrap();
+    setup(&mut renderer);
+    let mut layout = vk::ImageLayout::UNDEFINED;
+    for _ in 0..100 {
+        let stats = renderer
+            .render(
+                camera,
+                &target.target(CLEAR),
+                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                &[],
+                &[],
+            )
+            .unwrap();
+        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        if stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0 {
+            break;
+        }
+    }
+    let image = target.read(ctx).unwrap();
+    renderer.destroy();
+    target.destroy(ctx);
+    image
 }

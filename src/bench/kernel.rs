@@ -17,7 +17,7 @@ use crate::{
     river::samples::{patch_samples, PatchFrame},
     runtime::{
         cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
-        lod::{select_over, LodParams},
+        lod::{select, LodParams},
     },
     world::World,
 };
@@ -97,9 +97,7 @@ pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Ve
     for frame in 0..frames {
         let camera = flight.camera(world, frame);
         let frustum = Frustum::from_matrix(camera.clip());
-        for s in select_over(camera.position, &params, &|d| {
-            world.planet.surface_height(d)
-        }) {
+        for s in select(camera.position, &params) {
             let (c, r) = bounding_sphere(s.patch, radius, heights);
             if beyond_horizon(s.patch, camera.position, radius, heights)
                 || !frustum.touches_sphere(c, r)

@@ -58,6 +58,12 @@ pub fn face_of(direction: DVec3) -> (usize, f64, f64) {
     (face, p.dot(u_axis), p.dot(v_axis))
 }
 
+/// The angle between two directions, accurate for tiny angles too (atan2 of the cross and dot products; the
+/// arc cosine of the dot product loses all precision below about 1e-7 rad, the size of a level-20 patch).
+pub fn angle(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
 /// An edge of a face, named by where it lies in (u, v).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Edge {
@@ -191,6 +197,16 @@ impl PatchId {
     /// The projected centre of the patch on the unit sphere (used by Eq. 6.1).
     pub fn center(self) -> DVec3 {
         self.sphere_point(0.5, 0.5)
+    }
+
+    /// Angular radius of the patch around its centre: the spherical cap of this radius contains the patch (its
+    /// edges are great-circle arcs between the corners).
+    pub fn cap_angle(self) -> f64 {
+        let centre = self.center();
+        self.corners()
+            .iter()
+            .map(|c| angle(*c, centre))
+            .fold(0.0, f64::max)
     }
 
     /// The four corners on the unit sphere: (0,0), (1,0), (0,1), (1,1).

@@ -102,6 +102,9 @@ pub struct Planet {
     pub precomputed_level: u32,
     /// The diamond-square rule of every finer level.
     pub rule: DetailRule,
+    /// Per level 0..=precomputed_level, per patch (face, then row-major): lowest and highest height of the
+    /// patch's points, border included.
+    bounds: Vec<Vec<(f32, f32)>>,
     pub mountains: Vec<Mountain>,
     pub features: Option<FeaturePoints>,
     pub stats: PlanetStats,
@@ -278,6 +281,7 @@ impl Planet {
         mut stats: PlanetStats,
     ) -> Self {
         stats.mountains = mountains.len();
+        let bounds = patch_bounds_pyramid(&lattice, precomputed_level, config.rendering.vertices);
         stats.memory_bytes = lattice.bytes();
         log::info!("planet: {stats:?}");
         Self {
@@ -288,6 +292,7 @@ impl Planet {
             lattice,
             precomputed_level,
             rule,
+            bounds,
             mountains,
             features,
             stats,
@@ -312,10 +317,20 @@ impl Planet {
         bottom * (1.0 - fy) + top * fy
     }
 
-    /// The height of the visible surface (terrain or sea) above the sphere at a unit direction, on the
-    /// precomputed lattice: where the level of detail measures distances from.
-    pub fn surface_height(&self, direction: DVec3) -> f64 {
-        self.height_at(direction).max(self.sea_level) as f64
+    /// Lowest and highest base height any point of `patch` can have, at any level: its own range for
+    /// precomputed levels, the precomputed ancestor's widened by what finer levels add otherwise.
+    pub fn patch_bounds(&self, patch: PatchId) -> (f32, f32) {
+        let level = (patch.level as u32).min(self.precomputed_level);
+        let shift = patch.level as u32 - level;
+        let count = 1usize << level;
+        let (x, y) = ((patch.x >> shift) as usize, (patch.y >> shift) as usize);
+        let (lo, hi) = self.bounds[level as usize][(patch.face as usize * count + y) * count + x];
+        let extra = if shift > 0 {
+            self.rule.remaining_range(level)
+        } else {
+            0.0
+        };
+        (lo - extra, hi + extra)
     }
 
     /// Whether a direction is land on the base terrain (above sea level).
@@ -382,6 +397,46 @@ impl Planet {
         }
         out
     }
+}
+
+/// The height range of every patch of levels 0..=`top`, from the lattice of level `top`: level `top` with its
+/// border (what its descendants are refined from), coarser levels as the union of their children (which holds
+/// every vertex of theirs).
+fn patch_bounds_pyramid(lattice: &FaceLattice, top: u32, n: u32) -> Vec<Vec<(f32, f32)>> {
+    let count = 1u32 << top;
+    let finest: Vec<(f32, f32)> = (0..FACES as u32 * count * count)
+        .into_par_iter()
+        .map(|k| {
+            let patch = PatchId {
+                face: (k / (count * count)) as u8,
+                level: top as u8,
+                x: k % count,
+                y: (k / count) % count,
+            };
+            lattice.patch_heights(patch, n).range()
+        })
+        .collect();
+    let mut levels = vec![finest];
+    for level in (0..top).rev() {
+        let count = 1usize << level;
+        let finer = levels.last().expect("the finest level is there");
+        let coarse: Vec<(f32, f32)> = (0..FACES * count * count)
+            .map(|k| {
+                let (face, y, x) = (k / (count * count), (k / count) % count, k % count);
+                (0..4)
+                    .map(|q| {
+                        let (cx, cy) = (2 * x + (q & 1), 2 * y + (q >> 1));
+                        finer[(face * 2 * count + cy) * 2 * count + cx]
+                    })
+                    .fold((f32::MAX, f32::MIN), |(lo, hi), (a, b)| {
+                        (lo.min(a), hi.max(b))
+                    })
+            })
+            .collect();
+        levels.push(coarse);
+    }
+    levels.reverse();
+    levels
 }
 
 /// Spreads the base lattice onto the lattice of level `to` and runs diamond-square from the base level up to it

@@ -30,6 +30,7 @@ use crate::{
     },
     refine::{
         create_height_texture, prepare_height_textures, with_ancestors, HeightRefiner, RefineJob,
+        RefinedRanges,
     },
     river::{
         network::RiverNetwork,
@@ -39,7 +40,7 @@ use crate::{
         cache::{PatchCache, PatchData},
         camera::Camera,
         cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
-        lod::{select_over, LodParams, Selected},
+        lod::{select, select_nearest, surface_bounds, threshold, LodParams, Selected},
     },
     shaders,
 };
@@ -65,6 +66,10 @@ impl WaterMode {
         }
     }
 }
+
+/// The mountain height the fragment shader's colour bands are drawn for (Appendix A's `max-mountain-height`);
+/// other planets scale the bands by their own mountain height.
+const COLOUR_BAND_MOUNTAIN_HEIGHT: f32 = 16.0;
 
 /// What the fragment shader shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -97,6 +102,7 @@ pub struct PatchInstance {
     axis_v: [f32; 4],
     tex_rect: [f32; 4],
     slots: [i32; 4],
+    morph: [f32; 4],
 }
 
 /// What one frame did, for the viewer, the benchmarks and the plots (Chapter 9).
@@ -162,6 +168,9 @@ pub struct Renderer<'w> {
     pub view_mode: ViewMode,
     pub wireframe_on: bool,
     pub freeze_lod: bool,
+    /// Beyond the thesis: patches selected by their nearest point and morphed towards their parent before a
+    /// switch (CDLOD); `false`: the thesis's Eq. 6.1 on patch centres and instant switching.
+    pub morphing: bool,
     /// Unit direction towards the sun; `None`: over the camera's shoulder.
     pub sun: Option<DVec3>,
     /// Keep each frame's kernel input in `last_batch` (for benchmarks that rerun it through every variant).
@@ -261,10 +270,30 @@ impl<'w> Renderer<'w> {
             view_mode: ViewMode::Shaded,
             wireframe_on: false,
             freeze_lod: false,
+            morphing: true,
             sun: None,
             capture_batches: false,
             last_batch: Vec::new(),
         })
+    }
+
+    /// A patch's morph parameters (std430 `morph` of the instance): where its vertices start morphing, one over
+    /// the morph band's length, and its texel offset in its parent's river texture. A patch is selected only
+    /// while its nearest point is within its level's switch distance, so every vertex of one that is about to
+    /// appear or disappear is at least that far away: fully morphed, it looks like its parent.
+    fn morph(&self, patch: PatchId) -> [f32; 4] {
+        if !self.morphing || patch.level == 0 {
+            return NO_MORPH;
+        }
+        let p = self.lod_params();
+        let end = threshold(p.radius, p.switch_factor, patch.level as u32);
+        let half = (self.config.rendering.vertices - 1) / 2;
+        [
+            (end * (1.0 - MORPH_BAND)) as f32,
+            (1.0 / (end * MORPH_BAND)) as f32,
+            ((patch.x & 1) * half) as f32,
+            ((patch.y & 1) * half) as f32,
+        ]
     }
 
     fn lod_params(&self) -> LodParams {
@@ -301,9 +330,17 @@ impl<'w> Renderer<'w> {
         let t = Instant::now();
         let selected = match (&self.frozen, self.freeze_lod) {
             (Some(frozen), true) => frozen.clone(),
-            _ => select_over(camera.position, &self.lod_params(), &|d| {
-                self.planet.surface_height(d)
-            }),
+            _ if self.morphing => {
+                let depth = self.config.river.basin_depth as f64;
+                let cache = &self.cache;
+                select_nearest(camera.position, &self.lod_params(), &|p| {
+                    let nearest = cache
+                        .nearest_resident(p)
+                        .map(|(q, data)| (q.level, data.height_range));
+                    surface_bounds(self.planet, depth, p, nearest)
+                })
+            }
+            _ => select(camera.position, &self.lod_params()),
         };
         self.frozen = Some(selected.clone());
         cpu.insert("lod".to_string(), ms_since(t));
@@ -397,7 +434,8 @@ impl<'w> Renderer<'w> {
         let t = Instant::now();
         let mut rec = Recorder::begin(ctx, "frame")?;
         self.profiler.reset(ctx);
-        let (bytes, river_patches) = self.upload_new_patches(&mut rec, &prepared)?;
+        let (bytes, river_patches, refined_ranges) =
+            self.upload_new_patches(&mut rec, &prepared)?;
         stats.temporary_sample_bytes = bytes;
         stats.river_patches = river_patches;
 
@@ -416,11 +454,25 @@ impl<'w> Renderer<'w> {
                     None => continue,
                 }
             };
+            // Morphing towards the parent, whose river data the vertices blend into (its base heights are the
+            // patch's own at the points that remain).
+            let morph = self.morph(s.patch);
+            let parent_river = match (source == s.patch, s.patch.parent()) {
+                (true, Some(parent)) if self.morphing => self
+                    .cache
+                    .touch(&parent)
+                    .and_then(|d| d.river.as_ref())
+                    .map_or(-1, |(_, slot)| slot.0 as i32),
+                _ => -1,
+            };
             let Some(data) = self.cache.touch(&source) else {
                 continue;
             };
-            let wet = data.river.is_some() || data.min_height < self.planet.sea_level;
-            drawn.push((instance(s, source, data, camera.position, radius, n), wet));
+            let wet = data.river.is_some() || data.height_range.0 < self.planet.sea_level;
+            let mut instance = instance(s, source, data, camera.position, radius, n);
+            instance.morph = morph;
+            instance.slots[3] = parent_river;
+            drawn.push((instance, wet));
         }
         let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 3);
         let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
@@ -475,7 +527,12 @@ impl<'w> Renderer<'w> {
                     ViewMode::PaintedRed => 2.0,
                 },
             ],
-            extra: [2.0, 0.0, 0.0, 0.0],
+            extra: [
+                2.0,
+                0.0,
+                self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
+                0.0,
+            ],
         };
         rec.raw_image_transition(
             target.color_image,
@@ -562,6 +619,11 @@ impl<'w> Renderer<'w> {
         let id = rec.submit_with(waits, signals)?;
         ctx.wait(id)?;
         cpu.insert("gpu wait".to_string(), ms_since(t));
+        if let Some(ranges) = refined_ranges {
+            for (patch, range) in ranges.read(ctx)? {
+                self.cache.set_height_range(&patch, range);
+            }
+        }
         for scope in self.profiler.read(ctx)? {
             *stats.gpu_ms.entry(scope.name).or_default() += scope.ms;
         }
@@ -574,20 +636,32 @@ impl<'w> Renderer<'w> {
             + stats.precomputed_height_bytes;
         stats.cpu_ms = cpu;
         stats.frame_ms = ms_since(start);
+        log::debug!(
+            "frame {}: {} selected, {} visible, {} new, {} pending, {} resident, deepest level {}, {:.1} ms",
+            stats.frame,
+            stats.selected_patches,
+            stats.visible_patches,
+            stats.new_patches,
+            stats.pending_patches,
+            stats.resident_patches,
+            stats.deepest_level,
+            stats.frame_ms
+        );
         Ok(stats)
     }
 
     /// Creates the textures of new patches; uploads the base heights of precomputed levels and refines the rest
     /// from their parents on the GPU (parents first, one dispatch per level); then computes all river textures in
-    /// one kernel dispatch. Returns the temporary bytes (samples, job tables) and how many patches have rivers.
+    /// one kernel dispatch. Returns the temporary bytes (samples, job tables), how many patches have rivers, and
+    /// where the refined patches' height ranges arrive.
     fn upload_new_patches(
         &mut self,
         rec: &mut Recorder,
         prepared: &[NewPatch],
-    ) -> Result<(u64, usize), GpuError> {
+    ) -> Result<(u64, usize, Option<RefinedRanges>), GpuError> {
         self.last_batch.clear();
         if prepared.is_empty() {
-            return Ok((0, 0));
+            return Ok((0, 0, None));
         }
         let ctx = self.ctx;
         let n = self.config.rendering.vertices;
@@ -613,12 +687,12 @@ impl<'w> Renderer<'w> {
         }
         let base_refs: Vec<&Image> = bases.iter().map(|(i, _)| i).collect();
         prepare_height_textures(rec, &base_refs);
-        // Slot and lowest height (border included) of each new patch: exact for uploaded ones, a bound for
-        // refined ones.
-        let mut made: HashMap<PatchId, (Slot, f32)> = HashMap::new();
+        // Slot and height range (border included) of each new patch: exact for uploaded ones, a bound for
+        // refined ones until the shader's own range is read back after the frame.
+        let mut made: HashMap<PatchId, (Slot, (f32, f32))> = HashMap::new();
         let mut jobs: Vec<RefineJob> = Vec::new();
         for (p, (image, slot)) in prepared.iter().zip(&bases) {
-            let min_height = match &p.heights {
+            let range = match &p.heights {
                 Some(heights) => {
                     rec.upload_image_layer(
                         image,
@@ -626,17 +700,17 @@ impl<'w> Renderer<'w> {
                         0,
                         bytemuck::cast_slice(&heights.data),
                     )?;
-                    heights.range().0
+                    heights.range()
                 }
                 None => {
                     let parent = p.patch.parent().expect("refined patches have parents");
-                    let (parent_slot, parent_min) = match made.get(&parent) {
+                    let (parent_slot, (lo, hi)) = match made.get(&parent) {
                         Some(&made) => made,
                         None => {
                             let data = self.cache.touch(&parent).ok_or_else(|| {
                                 GpuError::Invalid(format!("{:?} has no resident parent", p.patch))
                             })?;
-                            (data.base_slot, data.min_height)
+                            (data.base_slot, data.height_range)
                         }
                     };
                     jobs.push(RefineJob {
@@ -644,10 +718,11 @@ impl<'w> Renderer<'w> {
                         slot: *slot,
                         parent_slot,
                     });
-                    parent_min - self.planet.rule.remaining_range(p.patch.level as u32 - 1)
+                    let extra = self.planet.rule.remaining_range(p.patch.level as u32 - 1);
+                    (lo - extra, hi + extra)
                 }
             };
-            made.insert(p.patch, (*slot, min_height));
+            made.insert(p.patch, (*slot, range));
         }
         rec.memory_barrier(
             vk::PipelineStageFlags2::COPY,
@@ -656,12 +731,14 @@ impl<'w> Renderer<'w> {
             vk::AccessFlags2::SHADER_SAMPLED_READ,
         );
         let mut bytes = 0;
+        let mut ranges = None;
         if !jobs.is_empty() {
             let scope = self.profiler.begin(rec, "heights")?;
-            bytes += self
+            ranges = self
                 .refiner
                 .record(rec, &self.bindless, self.planet, &jobs)?;
             self.profiler.end(rec, scope);
+            bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
         rec.memory_barrier(
             vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::COPY,
@@ -722,7 +799,7 @@ impl<'w> Renderer<'w> {
                 PatchData::new(base, slot, river, p.samples.len(), made[&p.patch].1),
             );
         }
-        Ok((bytes, river_count))
+        Ok((bytes, river_count, ranges))
     }
 
     /// A free bindless slot, evicting the least recently used patches if none is left.
@@ -805,7 +882,15 @@ fn instance(
             data.base_slot.0 as i32,
             data.river.as_ref().map_or(-1, |(_, s)| s.0 as i32),
             selected.quadrants as i32,
-            0,
+            -1,
         ],
+        morph: NO_MORPH,
     }
 }
+
+/// Morph distances that never morph (the level-0 patches, and the thesis's instant switching).
+const NO_MORPH: [f32; 4] = [f32::MAX, 1.0, 0.0, 0.0];
+
+/// Share of a level's switch distance over which its patches morph into their parent's shape (CDLOD's morph
+/// region): from 70 % of the distance on, fully at it.
+const MORPH_BAND: f64 = 0.3;

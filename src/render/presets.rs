@@ -18,6 +18,9 @@ pub enum Preset {
     Ground,
 }
 
+/// The radius of Appendix A's planet, for which the presets' distances were chosen.
+const APPENDIX_A_RADIUS: f64 = 1024.0;
+
 /// Height of the ground preset's eye above the river's water, in world units.
 pub const GROUND_EYE_HEIGHT: f64 = 2.0;
 
@@ -27,6 +30,9 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
     let r = world.planet.radius;
     let up = |d: DVec3| d.normalize();
     let height = |d: DVec3| world.planet.height_at(d) as f64;
+    // Distances were chosen on Appendix A's planet (radius 1024) and scale with the radius.
+    let unit = r / APPENDIX_A_RADIUS;
+    let sea = world.planet.sea_level as f64;
     Some(match preset {
         Preset::Orbit => {
             let d = up(system.source + DVec3::Y * 0.25);
@@ -37,7 +43,7 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             let away = (system.source - system.mouth).normalize();
             let eye_dir = up(top + away * 0.06);
             (
-                eye_dir * (r + height(eye_dir).max(0.0) + 70.0),
+                eye_dir * (r + height(eye_dir).max(sea) + 70.0 * unit),
                 top * (r + height(top)),
             )
         }
@@ -50,12 +56,13 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
                         .curve
                         .derivative(0.5)
                         .normalize()
-                        * 40.0,
+                        * 40.0
+                        * unit,
             );
             let back = (target - along).normalize();
             let eye_dir = up(target + back * 0.03);
             (
-                eye_dir * (r + height(eye_dir).max(0.4) + 25.0),
+                eye_dir * (r + height(eye_dir).max(sea) + 25.0 * unit),
                 target * (r + height(target)),
             )
         }

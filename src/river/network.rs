@@ -283,6 +283,8 @@ pub struct RiverNetwork {
     pub hull_levels: u32,
     pub influence_distance: f64,
     pub samples_per_half_width: u32,
+    /// At most this many samples per vertex spacing (0: no limit; `samples-per-vertex-spacing`).
+    pub samples_per_vertex_spacing: u32,
     /// Sources that found no river within `max-attempts` directions.
     pub abandoned_sources: usize,
 }
@@ -339,6 +341,7 @@ impl RiverNetwork {
             hull_levels: r.hull_levels,
             influence_distance: r.influence_distance as f64,
             samples_per_half_width: r.samples_per_half_width,
+            samples_per_vertex_spacing: r.samples_per_vertex_spacing,
             abandoned_sources: abandoned,
         }
     }

@@ -51,22 +51,12 @@ impl PatchFrame {
             .map(|p| system.frame.to_plane(*p))
             .collect()
     }
-
-    /// Angular radius of the patch around its centre.
-    fn cap_angle(&self) -> f64 {
-        let centre = self.patch.center();
-        self.patch
-            .corners()
-            .iter()
-            .map(|c| c.angle_between(centre))
-            .fold(0.0, f64::max)
-    }
 }
 
 /// Section 6.3: whether `system`'s extended hull meets the patch.
 pub fn influences(system: &RiverSystem, frame: &PatchFrame) -> bool {
-    if system.frame.centre.angle_between(frame.patch.center())
-        > system.cap_angle + frame.cap_angle()
+    if cube::angle(system.frame.centre, frame.patch.center())
+        > system.cap_angle + frame.patch.cap_angle()
     {
         return false;
     }
@@ -144,7 +134,8 @@ fn emit(
 
 /// Samples of one piece over t in [0, 1) (the next piece starts where this one ends), each with its river-frame
 /// position. Spacing: half the prescribed `width / (2 x samples-per-half-width)` in the river frame, because the
-/// patch frame can stretch up to 1.8 times more along the flow than across it.
+/// patch frame can stretch up to 1.8 times more along the flow than across it; with `samples-per-vertex-spacing`
+/// set, at least that share of the patch's vertex spacing (beyond the thesis).
 pub fn piece_samples<'a>(
     network: &'a RiverNetwork,
     system: &'a RiverSystem,
@@ -152,6 +143,10 @@ pub fn piece_samples<'a>(
     piece: &'a Segment,
 ) -> impl Iterator<Item = (DVec2, RiverSample)> + 'a {
     let per_half_width = network.samples_per_half_width as f64;
+    let floor = match network.samples_per_vertex_spacing {
+        0 => 0.0,
+        k => frame.spacing() / k as f64,
+    };
     let transform = move |p: DVec2| frame.to_patch(system.frame.to_sphere(p));
     let h = 1e-3 * network.influence_distance;
     let mut t = 0.0;
@@ -175,7 +170,7 @@ pub fn piece_samples<'a>(
             piece.height_at(t),
             (width * stretch) as f32,
         );
-        t += (width / (2.0 * per_half_width) * 0.5) / speed;
+        t += (width / (2.0 * per_half_width) * 0.5).max(floor) / speed;
         Some((p, sample))
     })
 }

@@ -19,8 +19,9 @@ pub struct PatchData {
     pub base_slot: Slot,
     pub river: Option<(Image, Slot)>,
     pub samples: usize,
-    /// Lowest base height (with the border), to know whether the patch can show sea.
-    pub min_height: f32,
+    /// Lowest and highest base height (with the border): whether the patch can show sea, and the bounds of its
+    /// vertices for the level of detail. Exact once known (uploaded, or read back after refinement).
+    pub height_range: (f32, f32),
     last_used: u64,
 }
 
@@ -30,14 +31,14 @@ impl PatchData {
         base_slot: Slot,
         river: Option<(Image, Slot)>,
         samples: usize,
-        min_height: f32,
+        height_range: (f32, f32),
     ) -> Self {
         Self {
             base,
             base_slot,
             river,
             samples,
-            min_height,
+            height_range,
             last_used: 0,
         }
     }
@@ -94,6 +95,25 @@ impl PatchCache {
     pub fn insert(&mut self, patch: PatchId, mut data: PatchData) {
         data.last_used = self.frame;
         self.entries.insert(patch, data);
+    }
+
+    /// Replaces a resident patch's height range (the exact one, read back after its refinement).
+    pub fn set_height_range(&mut self, patch: &PatchId, range: (f32, f32)) {
+        if let Some(e) = self.entries.get_mut(patch) {
+            e.height_range = range;
+        }
+    }
+
+    /// The patch itself if resident, or else its nearest resident ancestor, with its data.
+    pub fn nearest_resident(&self, patch: PatchId) -> Option<(PatchId, &PatchData)> {
+        let mut p = Some(patch);
+        while let Some(q) = p {
+            if let Some(data) = self.entries.get(&q) {
+                return Some((q, data));
+            }
+            p = q.parent();
+        }
+        None
     }
 
     /// The nearest resident ancestor of `patch`.

@@ -4,7 +4,7 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
-use crate::planet::cube::PatchId;
+use crate::planet::cube::{angle, PatchId};
 
 /// The six planes of a view frustum, inward normals, as (normal, distance): inside when `n . p + d >= 0`.
 #[derive(Clone, Copy, Debug)]
@@ -82,13 +82,7 @@ pub fn beyond_horizon(patch: PatchId, camera: DVec3, radius: f64, range: HeightR
     if distance <= low {
         return false;
     }
-    let centre = patch.center();
-    let spread = patch
-        .corners()
-        .iter()
-        .map(|c| c.angle_between(centre))
-        .fold(0.0, f64::max);
-    let nearest = (centre.angle_between(camera) - spread).max(0.0);
+    let nearest = (angle(patch.center(), camera) - patch.cap_angle()).max(0.0);
     let horizon = (low / distance).acos() + (low / high).min(1.0).acos();
     nearest > horizon
 }

@@ -2,7 +2,10 @@
 
 use glam::DVec3;
 
-use crate::planet::cube::{PatchId, FACES};
+use crate::planet::{
+    cube::{angle, PatchId, FACES},
+    Planet,
+};
 
 /// A patch to draw and which of its quadrants (bit q: child q, see [`PatchId::child`]) are not covered by finer
 /// patches.
@@ -29,30 +32,64 @@ pub struct LodParams {
 /// onto the planet's sphere (the thesis's rule), is below the threshold of the child's level; a visited patch
 /// draws the quadrants whose child was not visited (all four at the deepest level).
 pub fn select(camera: DVec3, params: &LodParams) -> Vec<Selected> {
-    select_over(camera, params, &|_| 0.0)
+    select_by(params, &|p| centre_distance(p, camera, params.radius))
 }
 
-/// [`select`] with patch centres lifted to the surface: `height(direction)` above the sphere. The thesis projects
-/// onto the sphere, which is the same while heights are tiny beside the radius; on an Earth-sized planet with
-/// heights in metres a camera over 300 m-high land would never come closer than 300 m to any centre, and detail
-/// would stop about level 17 (docs/rendering.md).
-pub fn select_over(
+/// Procedure 2 with the distance to the nearest point a patch can have (beyond the thesis, as CDLOD selects by
+/// a node's bounding box): `bounds(patch)` gives the lowest and highest height its vertices can take. Every
+/// vertex of a patch is then at least that far from the camera, so a patch appears (or disappears) only where
+/// all its vertices are beyond its level's threshold, where morphing has made it look like its parent
+/// (docs/rendering.md). On an Earth-sized planet it also keeps refining close above high ground, where the
+/// distance to the centre projected onto the sphere never falls below the ground's height.
+pub fn select_nearest(
     camera: DVec3,
     params: &LodParams,
-    height: &dyn Fn(DVec3) -> f64,
+    bounds: &dyn Fn(PatchId) -> (f64, f64),
 ) -> Vec<Selected> {
+    select_by(params, &|p| {
+        nearest_distance(p, camera, params.radius, bounds(p))
+    })
+}
+
+/// The heights every drawn point of `patch` lies between, for [`select_nearest`]: its base heights at any level
+/// (the planet's precomputed bound, narrowed by the range of the patch or of its nearest resident ancestor, which
+/// `nearest` gives with that ancestor's level), the sea surface, and a river basin's depth either way for river
+/// beds and water.
+pub fn surface_bounds(
+    planet: &Planet,
+    basin_depth: f64,
+    patch: PatchId,
+    nearest: Option<(u8, (f32, f32))>,
+) -> (f64, f64) {
+    let (mut lo, mut hi) = planet.patch_bounds(patch);
+    if let Some((level, (a, b))) = nearest {
+        let extra = if level == patch.level {
+            0.0
+        } else {
+            planet.rule.remaining_range(level as u32)
+        };
+        lo = lo.max(a - extra);
+        hi = hi.min(b + extra);
+    }
+    (
+        lo as f64 - basin_depth,
+        hi.max(planet.sea_level) as f64 + basin_depth,
+    )
+}
+
+/// Procedure 2 with any distance of a patch from the camera.
+fn select_by(params: &LodParams, distance: &dyn Fn(PatchId) -> f64) -> Vec<Selected> {
     let mut out = Vec::new();
     for face in 0..FACES {
-        visit(PatchId::root(face), camera, params, height, &mut out);
+        visit(PatchId::root(face), params, distance, &mut out);
     }
     out
 }
 
 fn visit(
     patch: PatchId,
-    camera: DVec3,
     params: &LodParams,
-    height: &dyn Fn(DVec3) -> f64,
+    distance: &dyn Fn(PatchId) -> f64,
     out: &mut Vec<Selected>,
 ) {
     if patch.level as u32 >= params.max_level {
@@ -65,8 +102,8 @@ fn visit(
     let mut quadrants = 0u8;
     for q in 0..4 {
         let child = patch.child(q);
-        if refines_over(child, camera, params, height) {
-            visit(child, camera, params, height, out);
+        if distance(child) < threshold(params.radius, params.switch_factor, child.level as u32) {
+            visit(child, params, distance, out);
         } else {
             quadrants |= 1 << q;
         }
@@ -78,17 +115,22 @@ fn visit(
 
 /// Whether `patch` is close enough to be visited (Eq. 6.1).
 pub fn refines(patch: PatchId, camera: DVec3, params: &LodParams) -> bool {
-    refines_over(patch, camera, params, &|_| 0.0)
+    centre_distance(patch, camera, params.radius)
+        < threshold(params.radius, params.switch_factor, patch.level as u32)
 }
 
-/// [`refines`] with the centre lifted by `height(direction)`.
-pub fn refines_over(
-    patch: PatchId,
-    camera: DVec3,
-    params: &LodParams,
-    height: &dyn Fn(DVec3) -> f64,
-) -> bool {
-    let direction = patch.center();
-    let centre = direction * (params.radius + height(direction));
-    camera.distance(centre) < threshold(params.radius, params.switch_factor, patch.level as u32)
+/// Eq. 6.1's distance: from the camera to the patch centre projected onto the sphere.
+fn centre_distance(patch: PatchId, camera: DVec3, radius: f64) -> f64 {
+    camera.distance(patch.center() * radius)
+}
+
+/// A lower bound of the distance from the camera to any point of `patch` with a height in `[lo, hi]`: the
+/// nearest point of the spherical cap around the patch, between those radii.
+pub fn nearest_distance(patch: PatchId, camera: DVec3, radius: f64, (lo, hi): (f64, f64)) -> f64 {
+    let rho = camera.length();
+    let phi = (angle(patch.center(), camera) - patch.cap_angle()).max(0.0);
+    let r = (rho * phi.cos()).clamp(radius + lo, radius + hi);
+    // |camera - r u|^2 = (rho - r)^2 + 4 rho r sin^2(phi / 2): no cancellation close to the surface.
+    let half = (0.5 * phi).sin();
+    ((rho - r).powi(2) + 4.0 * rho * r * half * half).sqrt()
 }
