@@ -139,6 +139,10 @@ void main() {
         if (dot(normal, direction) < 0.0) normal = -normal;
     }
 
+    if (WATER_PASS == 0 && frame.extra.w > 0.5) {
+        captured[gl_InstanceIndex * (n * n + 6 * n) + gl_VertexIndex] = vec4(position, 1.0 + morph);
+    }
+
     vPosition = position;
     vNormal = normal;
     vDirection = direction;

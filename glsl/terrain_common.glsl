@@ -11,7 +11,7 @@ layout(push_constant) uniform FramePush {
     // 1 level-of-detail colours, 2 painted rivers shown red).
     vec4 planet;
     // x: skirt depth in vertex spacings; y: time; z: height unit of the colour bands (max-mountain-height / 16,
-    // so that Appendix A's planet, whose mountains are 16 high, is coloured as before); w: unused.
+    // so that Appendix A's planet, whose mountains are 16 high, is coloured as before); w: 1 to capture vertices.
     vec4 extra;
 } frame;
 
@@ -35,6 +35,9 @@ struct PatchInstance {
 };
 
 layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance instances[]; };
+// Where the terrain pass puts every vertex when frame.extra.w is 1 (tests): per instance and mesh vertex, the
+// camera-relative position and 1 + morph factor.
+layout(set = 1, binding = 1, std430) writeonly buffer Captured { vec4 captured[]; };
 
 // Every patch texture is a 2D array view: base heights (1 layer, with a one-texel border), river data (2 layers).
 layout(set = 0, binding = 1) uniform sampler2DArray patchTextures[];

@@ -60,6 +60,10 @@ pub fn query(
         ("graphics+compute queue", family.is_some()),
         ("geometryShader", b(core.geometry_shader)),
         ("fillModeNonSolid (wireframe)", b(core.fill_mode_non_solid)),
+        (
+            "vertexPipelineStoresAndAtomics (vertex capture)",
+            b(core.vertex_pipeline_stores_and_atomics),
+        ),
         ("descriptorIndexing", b(v12.descriptor_indexing)),
         ("runtimeDescriptorArray", b(v12.runtime_descriptor_array)),
         (
@@ -144,7 +148,8 @@ impl EnabledFeatures {
         Self {
             core: vk::PhysicalDeviceFeatures::default()
                 .geometry_shader(true)
-                .fill_mode_non_solid(true),
+                .fill_mode_non_solid(true)
+                .vertex_pipeline_stores_and_atomics(true),
             v12: vk::PhysicalDeviceVulkan12Features::default()
                 .descriptor_indexing(true)
                 .runtime_descriptor_array(true)

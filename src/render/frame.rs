@@ -154,6 +154,8 @@ pub struct Renderer<'w> {
     water: GraphicsPipeline,
     wireframe: GraphicsPipeline,
     instance_layout: BufferSetLayout,
+    /// Bound in place of a capture buffer when vertices are not captured.
+    no_capture: Buffer,
     indices: Buffer,
     quadrant_ranges: [std::ops::Range<u32>; 4],
     all_indices: std::ops::Range<u32>,
@@ -177,6 +179,21 @@ pub struct Renderer<'w> {
     pub capture_batches: bool,
     /// The last frame's new river patches: (vertex spacing, samples).
     pub last_batch: Vec<(f32, Vec<RiverSample>)>,
+    /// Record where the terrain pass put every vertex in `last_capture` (tests of precision and morphing).
+    pub capture_vertices: bool,
+    pub last_capture: Option<VertexCapture>,
+}
+
+/// Every drawn terrain vertex of one frame, as the vertex shader placed it.
+#[derive(Clone, Debug)]
+pub struct VertexCapture {
+    /// The camera position the positions are relative to.
+    pub camera: DVec3,
+    /// Vertices per patch edge.
+    pub vertices: u32,
+    /// Per terrain instance: the patch drawn, and for every mesh vertex its camera-relative position and `1 +
+    /// morph factor` (0 for vertices of quadrants not drawn). Grid vertex (i, j) is at `j * vertices + i`.
+    pub patches: Vec<(PatchId, Vec<[f32; 4]>)>,
 }
 
 impl<'w> Renderer<'w> {
@@ -195,7 +212,13 @@ impl<'w> Renderer<'w> {
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
         let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
         let refiner = HeightRefiner::new(ctx, &bindless, n)?;
-        let instance_layout = BufferSetLayout::new(ctx, 1, "patch instances")?;
+        let instance_layout = BufferSetLayout::new(ctx, 2, "patch instances and vertex capture")?;
+        let no_capture = ctx.create_buffer(&BufferDesc {
+            name: "no vertex capture",
+            size: 16,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuOnly,
+        })?;
         let layouts = [bindless.layout, instance_layout.layout];
         // The terrain is drawn per quadrant without a geometry shader; the water pass has the geometry shader that
         // spawns water triangles (docs/rendering.md).
@@ -256,6 +279,7 @@ impl<'w> Renderer<'w> {
             water,
             wireframe,
             instance_layout,
+            no_capture,
             indices,
             quadrant_ranges: quadrants,
             all_indices: 0..mesh.len() as u32,
@@ -274,6 +298,8 @@ impl<'w> Renderer<'w> {
             sun: None,
             capture_batches: false,
             last_batch: Vec::new(),
+            capture_vertices: false,
+            last_capture: None,
         })
     }
 
@@ -336,7 +362,7 @@ impl<'w> Renderer<'w> {
                 select_nearest(camera.position, &self.lod_params(), &|p| {
                     let nearest = cache
                         .nearest_resident(p)
-                        .map(|(q, data)| (q.level, data.height_range));
+                        .map(|(q, data)| (q.level, data.surface_range()));
                     surface_bounds(self.planet, depth, p, nearest)
                 })
             }
@@ -442,7 +468,7 @@ impl<'w> Renderer<'w> {
         // Instances: every visible patch, with its own data or the part of its nearest resident ancestor. One list
         // per quadrant for the terrain (the instances that draw it), then one for the water (patches with a river
         // or below sea level), all in one buffer.
-        let mut drawn: Vec<(PatchInstance, bool)> = Vec::with_capacity(visible.len());
+        let mut drawn: Vec<(PatchInstance, bool, PatchId)> = Vec::with_capacity(visible.len());
         for s in &visible {
             let source = if self.cache.contains(&s.patch) {
                 stats.deepest_level = stats.deepest_level.max(s.patch.level as u32);
@@ -472,22 +498,22 @@ impl<'w> Renderer<'w> {
             let mut instance = instance(s, source, data, camera.position, radius, n);
             instance.morph = morph;
             instance.slots[3] = parent_river;
-            drawn.push((instance, wet));
+            drawn.push((instance, wet, s.patch));
         }
         let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 3);
+        let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
         let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
         for (q, range) in quadrant_instances.iter_mut().enumerate() {
             let first = instances.len() as u32;
-            instances.extend(
-                drawn
-                    .iter()
-                    .filter(|(i, _)| i.slots[2] & (1 << q) != 0)
-                    .map(|(i, _)| *i),
-            );
+            for (instance, _, patch) in drawn.iter().filter(|(i, _, _)| i.slots[2] & (1 << q) != 0)
+            {
+                instances.push(*instance);
+                instance_patches.push(*patch);
+            }
             *range = first..instances.len() as u32;
         }
         let first = instances.len() as u32;
-        instances.extend(drawn.iter().filter(|(_, wet)| *wet).map(|(i, _)| *i));
+        instances.extend(drawn.iter().filter(|(_, wet, _)| *wet).map(|(i, _, _)| *i));
         let water_instances = first..instances.len() as u32;
         let instance_buffer = {
             let mut buffer = ctx.create_buffer(&BufferDesc {
@@ -499,7 +525,34 @@ impl<'w> Renderer<'w> {
             buffer.write(0, &instances)?;
             buffer
         };
-        let instance_set = rec.buffer_set(&self.instance_layout, &[&instance_buffer])?;
+        // Vertex capture (tests): one slot per terrain instance and mesh vertex, zero where nothing was drawn.
+        let capture = if self.capture_vertices {
+            let size = (instance_patches.len().max(1) * mesh_vertices(n) as usize * 16) as u64;
+            let buffer = ctx.create_buffer(&BufferDesc {
+                name: "vertex capture",
+                size,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            })?;
+            rec.fill_buffer(&buffer, 0);
+            rec.buffer_barrier(
+                &buffer,
+                vk::PipelineStageFlags2::CLEAR,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::VERTEX_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            Some(buffer)
+        } else {
+            None
+        };
+        let instance_set = rec.buffer_set(
+            &self.instance_layout,
+            &[
+                &instance_buffer,
+                capture.as_ref().unwrap_or(&self.no_capture),
+            ],
+        )?;
         rec.free_after_completion(instance_buffer);
 
         // Section 8: terrain, then water.
@@ -531,7 +584,7 @@ impl<'w> Renderer<'w> {
                 2.0,
                 0.0,
                 self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
-                0.0,
+                self.capture_vertices as u32 as f32,
             ],
         };
         rec.raw_image_transition(
@@ -619,6 +672,25 @@ impl<'w> Renderer<'w> {
         let id = rec.submit_with(waits, signals)?;
         ctx.wait(id)?;
         cpu.insert("gpu wait".to_string(), ms_since(t));
+        self.last_capture = match capture {
+            Some(buffer) => {
+                let positions: Option<Vec<[f32; 4]>> = buffer
+                    .mapped()
+                    .map(|bytes| bytemuck::cast_slice(bytes).to_vec());
+                ctx.retire_buffer(buffer);
+                let per = mesh_vertices(n) as usize;
+                positions.map(|p| VertexCapture {
+                    camera: camera.position,
+                    vertices: n,
+                    patches: instance_patches
+                        .iter()
+                        .zip(p.chunks(per))
+                        .map(|(patch, v)| (*patch, v.to_vec()))
+                        .collect(),
+                })
+            }
+            None => None,
+        };
         if let Some(ranges) = refined_ranges {
             for (patch, range) in ranges.read(ctx)? {
                 self.cache.set_height_range(&patch, range);
@@ -796,7 +868,13 @@ impl<'w> Renderer<'w> {
             let river = river.and_then(|k| rivers[k].take());
             self.cache.insert(
                 p.patch,
-                PatchData::new(base, slot, river, p.samples.len(), made[&p.patch].1),
+                PatchData::new(
+                    (base, slot),
+                    river,
+                    p.samples.len(),
+                    made[&p.patch].1,
+                    river_range(&p.samples, self.config.river.basin_depth),
+                ),
             );
         }
         Ok((bytes, river_count, ranges))
@@ -830,9 +908,26 @@ impl<'w> Renderer<'w> {
         self.water.destroy(ctx);
         self.wireframe.destroy(ctx);
         self.instance_layout.destroy(ctx);
+        ctx.retire_buffer(self.no_capture);
         let _ = ctx.wait_idle();
         self.bindless.destroy(ctx);
     }
+}
+
+/// The heights river beds and water can take near `samples`: their heights widened by the basin depth.
+fn river_range(samples: &[RiverSample], basin_depth: f32) -> Option<(f32, f32)> {
+    samples
+        .iter()
+        .map(|s| s.height)
+        .fold(None, |range: Option<(f32, f32)>, h| {
+            Some(range.map_or((h, h), |(lo, hi)| (lo.min(h), hi.max(h))))
+        })
+        .map(|(lo, hi)| (lo - basin_depth, hi + basin_depth))
+}
+
+/// Vertices of the patch mesh: the grid and six skirts (render/mesh.rs).
+fn mesh_vertices(n: u32) -> u32 {
+    n * n + 6 * n
 }
 
 /// A patch that gets its data this frame: base heights from the precomputed lattice (`None`: refined on the GPU

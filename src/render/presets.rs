@@ -3,7 +3,10 @@
 
 use glam::DVec3;
 
-use crate::world::World;
+use crate::{
+    river::{network::finest_piece_near, samples::sample_step},
+    world::World,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
@@ -13,8 +16,9 @@ pub enum Preset {
     Mountains,
     /// Close above the first river's middle, looking along it.
     River,
-    /// Two world units (metres in config/earth.xml) above the first river's water at its middle, looking
-    /// downstream along it: the deepest levels of detail.
+    /// Two world units (metres in config/earth.xml) above the first river's water surface near its middle (the
+    /// middle of the segment nearest the river's middle that runs over land), looking downstream along it: the
+    /// deepest levels of detail.
     Ground,
 }
 
@@ -67,13 +71,35 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             )
         }
         Preset::Ground => {
-            let segment = &system.segments[system.segments.len() / 2];
-            let middle = segment.curve.point(0.5);
-            let water = segment.height_at(0.5) as f64;
+            // The segment nearest the river's middle whose middle runs over land above sea level (a river of
+            // the thesis's model may cross a bay on its way and run on at the bay's depth).
+            let count = system.segments.len();
+            let on_land = |s: &&crate::river::network::Segment| {
+                world
+                    .planet
+                    .is_land(system.frame.to_sphere(s.curve.point(0.5)))
+                    && s.height_at(0.5) > world.planet.sea_level
+            };
+            let mut by_distance: Vec<usize> = (0..count).collect();
+            by_distance.sort_by_key(|k| k.abs_diff(count / 2));
+            let segment = by_distance
+                .iter()
+                .map(|&k| &system.segments[k])
+                .find(on_land)
+                .unwrap_or(&system.segments[count / 2]);
+            // Where the deepest levels draw the river: its finest piece there.
+            let network = &world.network;
+            let finest = sample_step(network, segment.narrowest());
+            let piece =
+                finest_piece_near(segment, segment.curve.point(0.5), finest, &network.params);
+            let middle = piece.curve.point(0.5);
+            // The kernel's water surface in a river (Procedure 5): the basin's top less the water offset.
+            let river = &world.config.river;
+            let water = (piece.height_at(0.5) + river.basin_depth - river.basin_water_offset)
+                .max(world.planet.sea_level) as f64;
             let here = up(system.frame.to_sphere(middle));
             // Look at the water 25 eye heights downstream.
-            let ahead =
-                middle + segment.curve.derivative(0.5).normalize() * 25.0 * GROUND_EYE_HEIGHT;
+            let ahead = middle + piece.curve.derivative(0.5).normalize() * 25.0 * GROUND_EYE_HEIGHT;
             let ahead = up(system.frame.to_sphere(ahead));
             (here * (r + water + GROUND_EYE_HEIGHT), ahead * (r + water))
         }

@@ -92,6 +92,11 @@ impl Segment {
     }
 
     /// Length of the Bézier control polygon (at least the curve's length).
+    /// The smaller of the widths at the two ends.
+    pub fn narrowest(&self) -> f64 {
+        self.widths.0.min(self.widths.1) as f64
+    }
+
     pub fn polygon_length(&self) -> f64 {
         let c = self.curve.control_points();
         c[0].distance(c[1]) + c[1].distance(c[2]) + c[2].distance(c[3])
@@ -273,6 +278,31 @@ pub fn pieces_to_depth(
         }
     }
     out
+}
+
+/// The finest piece of `segment`'s own branch near `point` (a frame position), subdivided until it is at most
+/// `length` long (or [`MAX_DEPTH`] deep): the river as patches of the deepest levels draw it, which meanders away
+/// from the coarse curve by the displacements of every subdivision. Descends one child at a time.
+pub fn finest_piece_near(
+    segment: &Segment,
+    point: DVec2,
+    length: f64,
+    params: &SubdivisionParams,
+) -> Segment {
+    let mut piece = *segment;
+    while piece.depth < MAX_DEPTH && piece.polygon_length() > length {
+        let (children, _) = subdivide(&piece, params);
+        let distance = |s: &Segment| {
+            (0..=8)
+                .map(|k| s.curve.point(k as f64 / 8.0).distance(point))
+                .fold(f64::MAX, f64::min)
+        };
+        piece = children
+            .into_iter()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+            .unwrap_or(piece);
+    }
+    piece
 }
 
 /// All river systems of a planet.

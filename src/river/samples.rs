@@ -83,7 +83,8 @@ pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> Vec<RiverSam
         let Some(outline) = frame.outline_in(system) else {
             continue;
         };
-        let target = 4.0 * frame.spacing();
+        // Pieces no shorter than the samples on them are apart: a shorter one still gets a sample of its own, so
+        // near a deep patch (2 cm between vertices) millions of pieces would give millions of samples.
         // A sample matters if it is within reach of the patch; the factor 2 covers the face plane's stretch.
         let reach = 2.0 * network.influence_distance;
         let mut stack: Vec<Segment> = system.segments.iter().rev().copied().collect();
@@ -101,6 +102,7 @@ pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> Vec<RiverSam
             if hull::distance(&outline, centre) > bound + reach {
                 continue;
             }
+            let target = (4.0 * frame.spacing()).max(sample_step(network, piece.narrowest()));
             if length <= target || piece.depth >= MAX_DEPTH {
                 emit(network, system, frame, &outline, &piece, reach, &mut out);
             } else {
@@ -132,17 +134,22 @@ fn emit(
     );
 }
 
+/// The distance between samples along a river of `width` (6.4): half the prescribed `width / (2 x
+/// samples-per-half-width)` in the river frame, because the patch frame can stretch up to 1.8 times more along the
+/// flow than across it.
+pub fn sample_step(network: &RiverNetwork, width: f64) -> f64 {
+    width / (2.0 * network.samples_per_half_width as f64) * 0.5
+}
+
 /// Samples of one piece over t in [0, 1) (the next piece starts where this one ends), each with its river-frame
-/// position. Spacing: half the prescribed `width / (2 x samples-per-half-width)` in the river frame, because the
-/// patch frame can stretch up to 1.8 times more along the flow than across it; with `samples-per-vertex-spacing`
-/// set, at least that share of the patch's vertex spacing (beyond the thesis).
+/// position, [`sample_step`] apart; with `samples-per-vertex-spacing` set, at least that share of the patch's
+/// vertex spacing apart (beyond the thesis).
 pub fn piece_samples<'a>(
     network: &'a RiverNetwork,
     system: &'a RiverSystem,
     frame: &'a PatchFrame,
     piece: &'a Segment,
 ) -> impl Iterator<Item = (DVec2, RiverSample)> + 'a {
-    let per_half_width = network.samples_per_half_width as f64;
     let floor = match network.samples_per_vertex_spacing {
         0 => 0.0,
         k => frame.spacing() / k as f64,
@@ -170,7 +177,7 @@ pub fn piece_samples<'a>(
             piece.height_at(t),
             (width * stretch) as f32,
         );
-        t += (width / (2.0 * per_half_width) * 0.5).max(floor) / speed;
+        t += sample_step(network, width).max(floor) / speed;
         Some((p, sample))
     })
 }

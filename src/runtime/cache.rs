@@ -22,16 +22,19 @@ pub struct PatchData {
     /// Lowest and highest base height (with the border): whether the patch can show sea, and the bounds of its
     /// vertices for the level of detail. Exact once known (uploaded, or read back after refinement).
     pub height_range: (f32, f32),
+    /// The heights river beds and water can take in the patch (its samples' heights widened by the basin
+    /// depth), which may lie below the base heights where a river cuts through high ground.
+    pub river_range: Option<(f32, f32)>,
     last_used: u64,
 }
 
 impl PatchData {
     pub fn new(
-        base: Image,
-        base_slot: Slot,
+        (base, base_slot): (Image, Slot),
         river: Option<(Image, Slot)>,
         samples: usize,
         height_range: (f32, f32),
+        river_range: Option<(f32, f32)>,
     ) -> Self {
         Self {
             base,
@@ -39,8 +42,16 @@ impl PatchData {
             river,
             samples,
             height_range,
+            river_range,
             last_used: 0,
         }
+    }
+
+    /// Lowest and highest height a drawn vertex of the patch can have: base heights and river beds.
+    pub fn surface_range(&self) -> (f32, f32) {
+        let (lo, hi) = self.height_range;
+        self.river_range
+            .map_or((lo, hi), |(a, b)| (lo.min(a), hi.max(b)))
     }
 
     pub fn bytes(&self) -> u64 {

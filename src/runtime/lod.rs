@@ -51,26 +51,27 @@ pub fn select_nearest(
     })
 }
 
-/// The heights every drawn point of `patch` lies between, for [`select_nearest`]: its base heights at any level
-/// (the planet's precomputed bound, narrowed by the range of the patch or of its nearest resident ancestor, which
-/// `nearest` gives with that ancestor's level), the sea surface, and a river basin's depth either way for river
-/// beds and water.
+/// The heights every drawn point of `patch` lies between, for [`select_nearest`]: the surface range (base heights
+/// and river beds) of the patch or of its nearest resident ancestor, which `nearest` gives with that ancestor's
+/// level, widened by what finer levels add; without one the planet's precomputed bound of its base heights.
+/// Then the sea surface, and a river basin's depth either way for river beds and water.
 pub fn surface_bounds(
     planet: &Planet,
     basin_depth: f64,
     patch: PatchId,
     nearest: Option<(u8, (f32, f32))>,
 ) -> (f64, f64) {
-    let (mut lo, mut hi) = planet.patch_bounds(patch);
-    if let Some((level, (a, b))) = nearest {
-        let extra = if level == patch.level {
-            0.0
-        } else {
-            planet.rule.remaining_range(level as u32)
-        };
-        lo = lo.max(a - extra);
-        hi = hi.min(b + extra);
-    }
+    let (lo, hi) = match nearest {
+        Some((level, (lo, hi))) => {
+            let extra = if level == patch.level {
+                0.0
+            } else {
+                planet.rule.remaining_range(level as u32)
+            };
+            (lo - extra, hi + extra)
+        }
+        None => planet.patch_bounds(patch),
+    };
     (
         lo as f64 - basin_depth,
         hi.max(planet.sea_level) as f64 + basin_depth,
