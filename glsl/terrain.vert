@@ -121,7 +121,7 @@ void main() {
     vec3 offset = directionOffset(p, morphed);
     vec3 direction = normalize(p.centreDir.xyz + offset);
     float height = surface.x;
-    if (skirt) height -= frame.extra.x * p.centreDir.w;
+    if (skirt) height -= p.texRect.w;
     vec3 position = positionAt(p, height, offset);
 
     // Normal from the four neighbours (one parent spacing apart when fully morphed); at the patch edges the

@@ -10,7 +10,7 @@ layout(push_constant) uniform FramePush {
     // x: radius; y: vertices per patch edge; z: water mode (0 auto, 1 geometry, 2 painted); w: view (0 shaded,
     // 1 level-of-detail colours, 2 painted rivers shown red).
     vec4 planet;
-    // x: skirt depth in vertex spacings; y: time; z: height unit of the colour bands (max-mountain-height / 16,
+    // x: unused; y: time; z: height unit of the colour bands (max-mountain-height / 16,
     // so that Appendix A's planet, whose mountains are 16 high, is coloured as before); w: 1 to capture vertices.
     vec4 extra;
 } frame;
@@ -28,7 +28,7 @@ struct PatchInstance {
     vec4 cubeCentre;  // xyz: the patch centre on the cube; w: its length
     vec4 axisU;       // xyz: cube-space step across the whole patch along i; w: 2 cubeCentre . axisU
     vec4 axisV;       // xyz: the same along j; w: 2 cubeCentre . axisV
-    vec4 texRect;     // xy: source texel of vertex (0, 0); z: source texels per vertex; w: unused
+    vec4 texRect;     // xy: source texel of vertex (0, 0); z: source texels per vertex; w: skirt length
     ivec4 slots;      // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: parent's river slot or -1
     vec4 morph;       // x: distance where morphing towards the parent starts; y: 1 / morph band length;
                       // zw: the patch's vertex (0, 0) in its parent's river texture

@@ -103,6 +103,11 @@ pub struct RenderingConfig {
     pub max_resident_patches: u32,
     /// New patches generated per frame at most; the rest draw their parent until their data arrives.
     pub new_patches_per_frame: u32,
+    /// GPU time per frame for making new patches (base heights and river data), in milliseconds: fewer patches
+    /// are made when the measured time per patch says the count would exceed it.
+    pub generation_budget_ms: f32,
+    /// Memory of resident patch textures at most, in MB (with max-resident-patches, whichever is smaller).
+    pub resident_memory_mb: u32,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -155,6 +160,8 @@ impl Default for Config {
                 level_of_detail_switch_factor: 8.0,
                 max_resident_patches: 2048,
                 new_patches_per_frame: 64,
+                generation_budget_ms: 8.0,
+                resident_memory_mb: 256,
             },
         }
     }
@@ -219,6 +226,8 @@ struct RawRendering {
     level_of_detail_switch_factor: Option<String>,
     max_resident_patches: Option<String>,
     new_patches_per_frame: Option<String>,
+    generation_budget_ms: Option<String>,
+    resident_memory_mb: Option<String>,
 }
 
 /// Reads one element's text into a typed value, with the file name for errors.
@@ -594,6 +603,19 @@ impl Config {
                 dg.new_patches_per_frame,
                 1,
                 1 << 16,
+            )?,
+            generation_budget_ms: r.f32(
+                "generation-budget-ms",
+                &g.generation_budget_ms,
+                dg.generation_budget_ms,
+                Range::Positive,
+            )?,
+            resident_memory_mb: r.u32(
+                "resident-memory-mb",
+                &g.resident_memory_mb,
+                dg.resident_memory_mb,
+                16,
+                1 << 20,
             )?,
         };
         // Lattice keys are 32-bit signed integers on the GPU (planet::detail): the finest lattice must keep its

@@ -198,6 +198,9 @@ enum BenchCommand {
         /// preset) instead of the thesis's path.
         #[arg(long, conflicts_with = "stress")]
         descent: bool,
+        /// With --descent: write the frames whose hole check fails to DIR/holes-FRAME.png.
+        #[arg(long, requires = "descent")]
+        hole_images: Option<PathBuf>,
         #[arg(long, default_value_t = 300)]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).
@@ -481,6 +484,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             seed,
             stress,
             descent,
+            hole_images,
             frames,
             speed,
             size,
@@ -505,6 +509,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 compare_kernels: !no_kernel_comparison,
                 compare_water_modes: !no_water_comparison,
                 descent,
+                hole_images,
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {
@@ -548,13 +553,15 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             );
             println!(
                 "  deepest level {}; peak memory {:.1} MB; frame ms median {:.1}, max after {} warm-up frames {:.1}; \
-                 at most {} patches made in a frame",
+                 at most {} patches made in a frame; {} hole pixels in {} checked frames",
                 s.deepest_level,
                 s.peak_memory_bytes as f64 / 1e6,
                 s.frame_ms_median,
                 bench::flight::WARMUP_FRAMES,
                 s.frame_ms_max_after_warmup,
-                s.max_generated_patches
+                s.max_generated_patches,
+                s.hole_pixels,
+                s.hole_checked_frames
             );
             println!("  gpu ms per frame: {:?}", s.average_gpu_ms);
             println!("  cpu ms per frame: {:?}", s.average_cpu_ms);

@@ -153,7 +153,8 @@ fn the_ground_preset_reaches_deep_levels_made_on_demand() {
     let config = dir.join("deep.xml");
     std::fs::write(
         &config,
-        "<planet><rendering-attributes><max-level-of-detail>24</max-level-of-detail></rendering-attributes></planet>",
+        "<planet><rendering-attributes><max-level-of-detail>24</max-level-of-detail>\
+         <generation-budget-ms>1000000</generation-budget-ms></rendering-attributes></planet>",
     )
     .unwrap();
     let out = riverplanet()

@@ -6,6 +6,7 @@ use std::{path::PathBuf, sync::OnceLock};
 
 use glam::DVec3;
 use riverplanet::{
+    bench::holes::{hole_pixels, HOLE_COLOUR},
     config::Config,
     gpu::{vk, Context},
     render::{
@@ -18,7 +19,7 @@ use riverplanet::{
 };
 
 const SEED: u32 = 1;
-const CLEAR: [f32; 4] = [1.0, 0.0, 1.0, 1.0];
+const CLEAR: [f32; 4] = HOLE_COLOUR;
 
 fn world() -> &'static World {
     static WORLD: OnceLock<World> = OnceLock::new();
@@ -151,30 +152,8 @@ fn no_pixel_inside_the_planet_shows_the_clear_colour() {
             (altitude * 0.05).clamp(0.01, 10.0),
         );
         let image = render(ctx, &camera, size, WaterMode::Auto);
-        let inverse = camera.clip().inverse();
-        let mut holes = 0;
-        let mut inside = 0;
-        for (x, y, pixel) in image.enumerate_pixels() {
-            let ndc = |v: f64, n: u32| (v + 0.5) / n as f64 * 2.0 - 1.0;
-            let unproject = |z: f64| {
-                let p = inverse
-                    * glam::DVec4::new(ndc(x as f64, size[0]), ndc(y as f64, size[1]), z, 1.0);
-                p.truncate() / p.w
-            };
-            let (near, far) = (unproject(1.0), unproject(1e-6));
-            let dir = (far - near).normalize();
-            // The planet's disc: rays that hit a sphere well below the lowest terrain.
-            let b = near.dot(dir);
-            let c =
-                near.length_squared() - (r + world.planet.stats.min_height as f64 - 2.0).powi(2);
-            if b * b - c < 0.0 || -b - (b * b - c).sqrt() < 0.0 {
-                continue;
-            }
-            inside += 1;
-            if pixel.0[0] == 255 && pixel.0[1] == 0 && pixel.0[2] == 255 {
-                holes += 1;
-            }
-        }
+        let inner = r + world.planet.stats.min_height as f64 - 2.0;
+        let (holes, inside) = hole_pixels(&image, &camera, inner);
         if holes > 0 {
             let path = out_dir().join(format!("holes-{k}.png"));
             image.save(&path).unwrap();

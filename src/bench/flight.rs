@@ -6,7 +6,12 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::{kernel::VariantRunner, path::Flight, Threads};
+use super::{
+    holes::{hole_pixels, HOLE_COLOUR},
+    kernel::VariantRunner,
+    path::Flight,
+    Threads,
+};
 use crate::{
     config::Config,
     gpu::{vk, Context, GpuError},
@@ -36,6 +41,9 @@ pub struct FlightFrame {
     pub stats: FrameStats,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub kernels: Option<FrameKernels>,
+    /// Pixels inside the planet's disc showing the clear colour (the descent checks every tenth frame).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hole_pixels: Option<usize>,
 }
 
 /// Averages and maxima over a flight.
@@ -79,7 +87,15 @@ pub struct FlightSummary {
     /// Patches made per frame (base heights refined or cut, river data computed), at most.
     #[serde(default)]
     pub max_generated_patches: usize,
+    /// Frames checked for holes, and hole pixels found in all of them.
+    #[serde(default)]
+    pub hole_checked_frames: usize,
+    #[serde(default)]
+    pub hole_pixels: usize,
 }
+
+/// The descent checks every this many frames for holes.
+pub const HOLE_CHECK_EVERY: u32 = 10;
 
 /// Frames not counted in `frame_ms_max_after_warmup`.
 pub const WARMUP_FRAMES: usize = 10;
@@ -115,6 +131,8 @@ pub struct FlightOptions {
     pub compare_water_modes: bool,
     /// Fly the descent to the ground instead of the thesis's path.
     pub descent: bool,
+    /// Where to write the images of frames the hole check fails on (`holes-FRAME.png`).
+    pub hole_images: Option<std::path::PathBuf>,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -159,12 +177,20 @@ fn fly(
     };
     let mut frames = Vec::with_capacity(options.frames as usize);
     let mut layout = vk::ImageLayout::UNDEFINED;
+    // Below the lowest height anything is drawn at: rays hitting this sphere must hit terrain or water.
+    let inner = world.planet.radius + world.planet.height_bounds().0 as f64
+        - config.river.basin_depth as f64
+        - 1.0;
     let result = (|| {
         for frame in 0..options.frames {
             let camera = flight.camera(world, frame);
             let stats = renderer.render(
                 &camera,
-                &target.target([0.02, 0.03, 0.06, 1.0]),
+                &target.target(if options.descent {
+                    HOLE_COLOUR
+                } else {
+                    [0.02, 0.03, 0.06, 1.0]
+                }),
                 (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
                 &[],
                 &[],
@@ -185,11 +211,25 @@ fn fly(
                 }
                 _ => None,
             };
+            let hole_pixels = if options.descent && frame % HOLE_CHECK_EVERY == 0 {
+                let image = target.read(ctx)?;
+                let holes = hole_pixels(&image, &camera, inner).0;
+                if let (true, Some(dir)) = (holes > 0, &options.hole_images) {
+                    let path = dir.join(format!("holes-{frame}.png"));
+                    image.save(&path).map_err(|e| {
+                        GpuError::Invalid(format!("cannot write {}: {e}", path.display()))
+                    })?;
+                }
+                Some(holes)
+            } else {
+                None
+            };
             let altitude = camera.position.length() - world.planet.radius;
             frames.push(FlightFrame {
                 altitude,
                 stats,
                 kernels,
+                hole_pixels,
             });
             progress(frame);
         }
@@ -276,6 +316,8 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
             .copied()
             .fold(0.0, f64::max),
         max_generated_patches: stats.iter().map(|s| s.new_patches).max().unwrap_or(0),
+        hole_checked_frames: frames.iter().filter(|f| f.hole_pixels.is_some()).count(),
+        hole_pixels: frames.iter().filter_map(|f| f.hole_pixels).sum(),
         max_frame_ms: frame_ms.iter().copied().fold(0.0, f64::max),
         average_fps: if average_frame_ms > 0.0 {
             1000.0 / average_frame_ms

@@ -4,6 +4,7 @@
 //! rayon used.
 
 pub mod flight;
+pub mod holes;
 pub mod kernel;
 pub mod path;
 pub mod plot;

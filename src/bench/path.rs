@@ -45,9 +45,10 @@ impl Flight {
         }
     }
 
-    /// The descent to the ground preset in `frames` frames (`None` when the planet has no river): the altitude
-    /// falls geometrically from two radii (three from the centre) to the preset's eye, and the view turns from
-    /// the planet's centre to the preset's target.
+    /// The descent to the ground preset in `frames` frames (`None` when the planet has no river): in the first 60 %
+    /// (the thesis flight's share of descending) the altitude falls geometrically from two radii (three from the
+    /// centre) to the preset's eye while the view turns from the planet's centre to the preset's target; then the
+    /// camera stays two units above the water and turns a quarter round, so new views stream in at the bottom.
     pub fn descent(world: &World, frames: u32, aspect: f64) -> Option<Self> {
         let ground = crate::render::presets::camera(crate::render::presets::Preset::Ground, world)?;
         let mut flight = Self::new(world, frames, 1.0, aspect);
@@ -94,11 +95,14 @@ impl Flight {
     }
 
     fn descent_camera(&self, end: DVec3, target: DVec3, frame: u32) -> Camera {
-        let s = (frame as f64 / (self.frames - 1).max(1) as f64).min(1.0);
+        let progress = (frame as f64 / (self.frames - 1).max(1) as f64).min(1.0);
+        let s = (progress / DESCENT).min(1.0);
+        let turn = ((progress - DESCENT) / (1.0 - DESCENT)).max(0.0) * std::f64::consts::FRAC_PI_2;
         let ground = end.length() - GROUND_EYE_HEIGHT;
         let high = 3.0 * self.radius - ground;
         let altitude = high * (GROUND_EYE_HEIGHT / high).powf(s);
         let eye = end.normalize() * (ground + altitude);
+        let target = end + glam::DQuat::from_axis_angle(end.normalize(), turn) * (target - end);
         let look = DVec3::ZERO.lerp(target, s.powf(0.25));
         Camera::look_at(
             eye,

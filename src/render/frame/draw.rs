@@ -1,0 +1,454 @@
+//! Draw recording (Chapter 8): one instance per visible patch (its own data or the part of an ancestor standing
+//! in), with its morph towards its parent; the terrain drawn per quadrant, then the water through the geometry
+//! shader; optionally every terrain vertex captured as the vertex shader placed it.
+
+use std::collections::HashMap;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3};
+
+use super::{FrameStats, Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT};
+use crate::{
+    gpu::{
+        pipeline::RenderTarget, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
+    },
+    planet::cube::{cube_point, PatchId, EDGES, FACE_AXES},
+    river::samples::PatchFrame,
+    runtime::{
+        cache::PatchData,
+        camera::Camera,
+        lod::{threshold, Selected},
+    },
+};
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(super) struct FramePush {
+    view_projection: [[f32; 4]; 4],
+    sun: [f32; 4],
+    planet: [f32; 4],
+    extra: [f32; 4],
+}
+
+/// std430 mirror of `PatchInstance` in glsl/terrain_common.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PatchInstance {
+    centre_rel: [f32; 4],
+    centre_dir: [f32; 4],
+    cube_centre: [f32; 4],
+    axis_u: [f32; 4],
+    axis_v: [f32; 4],
+    tex_rect: [f32; 4],
+    slots: [i32; 4],
+    morph: [f32; 4],
+}
+
+/// Every drawn terrain vertex of one frame, as the vertex shader placed it.
+#[derive(Clone, Debug)]
+pub struct VertexCapture {
+    /// The camera position the positions are relative to.
+    pub camera: DVec3,
+    /// Vertices per patch edge.
+    pub vertices: u32,
+    /// Per terrain instance: the patch drawn, and for every mesh vertex its camera-relative position and `1 +
+    /// morph factor` (0 for vertices of quadrants not drawn). Grid vertex (i, j) is at `j * vertices + i`.
+    pub patches: Vec<(PatchId, Vec<[f32; 4]>)>,
+}
+
+/// What the recorded draws leave for after the frame: the vertex capture buffer and whose vertices it holds.
+pub(super) struct Drawn {
+    capture: Option<Buffer>,
+    instance_patches: Vec<PatchId>,
+}
+
+impl Drawn {
+    /// The captured vertices, once the frame has completed (the buffer is freed).
+    pub(super) fn read_capture(
+        self,
+        ctx: &Context,
+        camera: DVec3,
+        n: u32,
+    ) -> Option<VertexCapture> {
+        let buffer = self.capture?;
+        let positions: Option<Vec<[f32; 4]>> = buffer
+            .mapped()
+            .map(|bytes| bytemuck::cast_slice(bytes).to_vec());
+        ctx.retire_buffer(buffer);
+        let per = mesh_vertices(n) as usize;
+        positions.map(|p| VertexCapture {
+            camera,
+            vertices: n,
+            patches: self
+                .instance_patches
+                .iter()
+                .zip(p.chunks(per))
+                .map(|(patch, v)| (*patch, v.to_vec()))
+                .collect(),
+        })
+    }
+}
+
+fn to_f32(m: DMat4) -> [[f32; 4]; 4] {
+    m.as_mat4().to_cols_array_2d()
+}
+
+impl Renderer<'_> {
+    /// A patch's morph parameters (std430 `morph` of the instance): where its vertices start morphing, one over
+    /// the morph band's length, and its texel offset in its parent's river texture. A patch is selected only
+    /// while its nearest point is within its level's switch distance, so every vertex of one that is about to
+    /// appear or disappear is at least that far away: fully morphed, it looks like its parent.
+    fn morph(&self, patch: PatchId) -> [f32; 4] {
+        if !self.morphing || patch.level == 0 {
+            return NO_MORPH;
+        }
+        let p = self.lod_params();
+        let end = threshold(p.radius, p.switch_factor, patch.level as u32);
+        let half = (self.config.rendering.vertices - 1) / 2;
+        [
+            (end * (1.0 - MORPH_BAND)) as f32,
+            (1.0 / (end * MORPH_BAND)) as f32,
+            ((patch.x & 1) * half) as f32,
+            ((patch.y & 1) * half) as f32,
+        ]
+    }
+
+    /// The visible patches drawn from an ancestor's data, each with how far its surface can lie from the true one:
+    /// the span of that ancestor's heights (base and river beds).
+    fn stand_in_spans(&self, visible: &[Selected]) -> StandIns {
+        let drawn: HashMap<PatchId, f32> = visible
+            .iter()
+            .filter(|s| !self.cache.contains(&s.patch))
+            .filter_map(|s| {
+                let (_, data) = self.cache.nearest_resident(s.patch)?;
+                let (lo, hi) = data.surface_range();
+                Some((s.patch, hi - lo))
+            })
+            .collect();
+        let mut below: HashMap<PatchId, f32> = HashMap::new();
+        for (patch, span) in &drawn {
+            let mut p = patch.parent();
+            while let Some(q) = p {
+                let entry = below.entry(q).or_insert(0.0);
+                *entry = entry.max(*span);
+                p = q.parent();
+            }
+        }
+        StandIns { drawn, below }
+    }
+
+    /// Records the terrain and water passes of `visible` into `target`, whose colour image is in
+    /// `color_layouts.0` and is left in `color_layouts.1`.
+    pub(super) fn record_draw(
+        &mut self,
+        rec: &mut Recorder,
+        camera: &Camera,
+        visible: &[Selected],
+        (target, color_layouts): (&RenderTarget, (vk::ImageLayout, vk::ImageLayout)),
+        stats: &mut FrameStats,
+    ) -> Result<Drawn, GpuError> {
+        let ctx = self.ctx;
+        let radius = self.planet.radius;
+        let n = self.config.rendering.vertices;
+        // Instances: every visible patch, with its own data or the part of its nearest resident ancestor. One list
+        // per quadrant for the terrain (the instances that draw it), then one for the water (patches with a river
+        // or below sea level), all in one buffer.
+        let stand_ins = self.stand_in_spans(visible);
+        let mut drawn: Vec<(PatchInstance, bool, PatchId)> = Vec::with_capacity(visible.len());
+        for s in visible {
+            let source = if self.cache.contains(&s.patch) {
+                stats.deepest_level = stats.deepest_level.max(s.patch.level as u32);
+                s.patch
+            } else {
+                stats.fallback_patches += 1;
+                match self.cache.resident_ancestor(s.patch) {
+                    Some(a) => a,
+                    None => continue,
+                }
+            };
+            // Morphing towards the parent, whose river data the vertices blend into (its base heights are the
+            // patch's own at the points that remain).
+            let morph = self.morph(s.patch);
+            let parent_river = match (source == s.patch, s.patch.parent()) {
+                (true, Some(parent)) if self.morphing => self
+                    .cache
+                    .touch(&parent)
+                    .and_then(|d| d.river.as_ref())
+                    .map_or(-1, |(_, slot)| slot.0 as i32),
+                _ => -1,
+            };
+            let Some(data) = self.cache.touch(&source) else {
+                continue;
+            };
+            let wet = data.river.is_some() || data.height_range.0 < self.planet.sea_level;
+            let mut instance = instance(s, source, data, camera.position, radius, n);
+            instance.morph = morph;
+            instance.slots[3] = parent_river;
+            instance.tex_rect[3] =
+                SKIRT_SPACINGS * instance.centre_dir[3] + skirt_deficit(s.patch, &stand_ins);
+            drawn.push((instance, wet, s.patch));
+        }
+        let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 3);
+        let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
+        let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
+        for (q, range) in quadrant_instances.iter_mut().enumerate() {
+            let first = instances.len() as u32;
+            for (instance, _, patch) in drawn.iter().filter(|(i, _, _)| i.slots[2] & (1 << q) != 0)
+            {
+                instances.push(*instance);
+                instance_patches.push(*patch);
+            }
+            *range = first..instances.len() as u32;
+        }
+        let first = instances.len() as u32;
+        instances.extend(drawn.iter().filter(|(_, wet, _)| *wet).map(|(i, _, _)| *i));
+        let water_instances = first..instances.len() as u32;
+        let instance_buffer = {
+            let mut buffer = ctx.create_buffer(&BufferDesc {
+                name: "patch instances",
+                size: (instances.len().max(1) * std::mem::size_of::<PatchInstance>()) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })?;
+            buffer.write(0, &instances)?;
+            buffer
+        };
+        // Vertex capture (tests): one slot per terrain instance and mesh vertex, zero where nothing was drawn.
+        let capture = if self.capture_vertices {
+            let size = (instance_patches.len().max(1) * mesh_vertices(n) as usize * 16) as u64;
+            let buffer = ctx.create_buffer(&BufferDesc {
+                name: "vertex capture",
+                size,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuToCpu,
+            })?;
+            rec.fill_buffer(&buffer, 0);
+            rec.buffer_barrier(
+                &buffer,
+                vk::PipelineStageFlags2::CLEAR,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::VERTEX_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            Some(buffer)
+        } else {
+            None
+        };
+        let instance_set = rec.buffer_set(
+            &self.instance_layout,
+            &[
+                &instance_buffer,
+                capture.as_ref().unwrap_or(&self.no_capture),
+            ],
+        )?;
+        rec.free_after_completion(instance_buffer);
+
+        // Section 8: terrain, then water.
+        let sun = self.sun.unwrap_or_else(|| {
+            (camera.position.normalize() * 0.8
+                + camera.up.cross(camera.forward).normalize() * 0.5
+                + camera.up * 0.3)
+                .normalize()
+        });
+        let push = FramePush {
+            view_projection: to_f32(camera.projection() * camera.rotation()),
+            sun: [
+                sun.x as f32,
+                sun.y as f32,
+                sun.z as f32,
+                self.planet.sea_level,
+            ],
+            planet: [
+                radius as f32,
+                n as f32,
+                self.water_mode as u32 as f32,
+                match self.view_mode {
+                    ViewMode::Shaded => 0.0,
+                    ViewMode::Lod => 1.0,
+                    ViewMode::PaintedRed => 2.0,
+                },
+            ],
+            extra: [
+                0.0,
+                0.0,
+                self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
+                self.capture_vertices as u32 as f32,
+            ],
+        };
+        rec.raw_image_transition(
+            target.color_image,
+            vk::ImageAspectFlags::COLOR,
+            color_layouts.0,
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::NONE,
+            ),
+            (
+                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+            ),
+        );
+        rec.raw_image_transition(
+            target.depth_image,
+            vk::ImageAspectFlags::DEPTH,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            (
+                vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
+            ),
+        );
+        rec.begin_rendering(target, true);
+        let sets = [self.bindless.set, instance_set];
+        let push = bytemuck::bytes_of(&push);
+        let scope = self.profiler.begin(rec, "terrain")?;
+        let terrain = if self.wireframe_on {
+            &self.wireframe
+        } else {
+            &self.terrain
+        };
+        for (indices, instances) in self.quadrant_ranges.iter().zip(&quadrant_instances) {
+            rec.draw_indexed(
+                terrain,
+                &sets,
+                push,
+                &self.indices,
+                indices.clone(),
+                instances.clone(),
+            );
+        }
+        self.profiler.end(rec, scope);
+        let scope = self.profiler.begin(rec, "water")?;
+        if !self.wireframe_on {
+            rec.draw_indexed(
+                &self.water,
+                &sets,
+                push,
+                &self.indices,
+                self.all_indices.clone(),
+                water_instances,
+            );
+        }
+        self.profiler.end(rec, scope);
+        rec.end_rendering();
+        if color_layouts.1 != vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL {
+            rec.raw_image_transition(
+                target.color_image,
+                vk::ImageAspectFlags::COLOR,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                color_layouts.1,
+                (
+                    vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                    vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
+                    vk::AccessFlags2::NONE,
+                ),
+            );
+        }
+        Ok(Drawn {
+            capture,
+            instance_patches,
+        })
+    }
+}
+
+/// Vertices of the patch mesh: the grid and six skirts (render/mesh.rs).
+fn mesh_vertices(n: u32) -> u32 {
+    n * n + 6 * n
+}
+
+/// The instance that draws `selected` from `source`'s textures (itself, or an ancestor standing in).
+fn instance(
+    selected: &Selected,
+    source: PatchId,
+    data: &PatchData,
+    camera: DVec3,
+    radius: f64,
+    n: u32,
+) -> PatchInstance {
+    let p = selected.patch;
+    let centre = p.center();
+    let rel = centre * radius - camera;
+    // The patch's frame on the cube, in f64: its centre and the steps across it (docs/rendering.md, "Precision").
+    let (_, a, b) = FACE_AXES[p.face as usize];
+    let (uc, vc) = p.uv(0.5, 0.5);
+    let cube_centre = cube_point(p.face as usize, uc, vc);
+    let (axis_u, axis_v) = (a * p.size(), b * p.size());
+    let with = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+    let depth = (p.level - source.level) as u32;
+    let scale = 1.0 / (1u32 << depth) as f32;
+    let offset_x = (p.x - (source.x << depth)) as f32 * scale * (n - 1) as f32;
+    let offset_y = (p.y - (source.y << depth)) as f32 * scale * (n - 1) as f32;
+    let spacing = PatchFrame::new(p, radius, n).spacing();
+    PatchInstance {
+        centre_rel: [rel.x as f32, rel.y as f32, rel.z as f32, p.level as f32],
+        centre_dir: [
+            centre.x as f32,
+            centre.y as f32,
+            centre.z as f32,
+            spacing as f32,
+        ],
+        cube_centre: with(cube_centre, cube_centre.length()),
+        axis_u: with(axis_u, 2.0 * cube_centre.dot(axis_u)),
+        axis_v: with(axis_v, 2.0 * cube_centre.dot(axis_v)),
+        tex_rect: [offset_x, offset_y, scale, 0.0],
+        slots: [
+            data.base_slot.0 as i32,
+            data.river.as_ref().map_or(-1, |(_, s)| s.0 as i32),
+            selected.quadrants as i32,
+            -1,
+        ],
+        morph: NO_MORPH,
+    }
+}
+
+/// Skirt length beside patches with their own data, in vertex spacings (docs/rendering.md, "No holes").
+const SKIRT_SPACINGS: f32 = 2.0;
+
+/// How much longer the skirts of `patch` must be than [`SKIRT_SPACINGS`]: where it or a neighbour is drawn from an
+/// ancestor's data, the two surfaces can part by as much as that ancestor's height span, and the higher side's
+/// skirt has to reach down to the lower. `spans` holds every visible stand-in and, for every patch above one, the
+/// largest span below it ([`StandIns`]), so a neighbour drawn coarser (an ancestor of the same-level neighbour) or
+/// finer (a descendant) is found either way.
+fn skirt_deficit(patch: PatchId, spans: &StandIns) -> f32 {
+    if spans.drawn.is_empty() {
+        return 0.0;
+    }
+    let covering = |p: PatchId| {
+        let mut q = Some(p);
+        while let Some(r) = q {
+            if let Some(span) = spans.drawn.get(&r) {
+                return *span;
+            }
+            q = r.parent();
+        }
+        0.0
+    };
+    std::iter::once(patch)
+        .chain(EDGES.map(|e| patch.neighbour(e)))
+        .map(|p| covering(p).max(spans.below.get(&p).copied().unwrap_or(0.0)))
+        .fold(0.0, f32::max)
+}
+
+/// The visible patches drawn from an ancestor's data with the span of that ancestor's heights, and for every
+/// patch above one of them the largest such span below it.
+struct StandIns {
+    drawn: HashMap<PatchId, f32>,
+    below: HashMap<PatchId, f32>,
+}
+
+/// Morph distances that never morph (the level-0 patches, and the thesis's instant switching).
+const NO_MORPH: [f32; 4] = [f32::MAX, 1.0, 0.0, 0.0];
+
+/// Share of a level's switch distance over which its patches morph into their parent's shape (CDLOD's morph
+/// region): from 70 % of the distance on, fully at it.
+const MORPH_BAND: f64 = 0.3;

@@ -1,0 +1,380 @@
+//! One frame (docs/rendering.md): the streaming plan (level of detail, culling, which patches get data:
+//! `plan`), the new patches' data (base heights uploaded or refined, river data from one kernel dispatch:
+//! `upload`), then the terrain and water passes (`draw`), each timed.
+
+mod draw;
+mod plan;
+mod upload;
+
+use std::{collections::BTreeMap, time::Instant};
+
+use glam::DVec3;
+use serde::Serialize;
+
+use self::draw::FramePush;
+pub use self::draw::{PatchInstance, VertexCapture};
+use super::mesh::{patch_mesh, PatchMesh};
+use crate::{
+    config::Config,
+    gpu::{
+        bindless::{Bindless, Slot},
+        pipeline::{BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
+        vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Profiler, Recorder,
+    },
+    kernel::{
+        gpu::{KernelTuning, KernelVariant, RiverKernel},
+        KernelParams, RiverSample,
+    },
+    planet::Planet,
+    refine::HeightRefiner,
+    river::network::RiverNetwork,
+    runtime::{cache::PatchCache, camera::Camera, cull::HeightRange, lod::Selected},
+    shaders,
+};
+
+/// How rivers are drawn (Section 8.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum WaterMode {
+    /// The thesis's rule: water geometry where the mesh resolves the river, painted elsewhere.
+    Auto,
+    /// Always emit water triangles in river basins.
+    Geometry,
+    /// Always paint rivers in the fragment shader (sea water stays geometry).
+    Painted,
+}
+
+impl WaterMode {
+    pub fn next(self) -> Self {
+        match self {
+            WaterMode::Auto => WaterMode::Geometry,
+            WaterMode::Geometry => WaterMode::Painted,
+            WaterMode::Painted => WaterMode::Auto,
+        }
+    }
+}
+
+/// The mountain height the fragment shader's colour bands are drawn for (Appendix A's `max-mountain-height`);
+/// other planets scale the bands by their own mountain height.
+const COLOUR_BAND_MOUNTAIN_HEIGHT: f32 = 16.0;
+
+/// What the fragment shader shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ViewMode {
+    Shaded,
+    /// Patches tinted by level of detail.
+    Lod,
+    /// Painted rivers in red (as in the thesis's Fig. 9.9).
+    PaintedRed,
+}
+
+/// What one frame did, for the viewer, the benchmarks and the plots (Chapter 9).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FrameStats {
+    pub frame: u64,
+    /// Patches selected by the level of detail (before culling).
+    pub selected_patches: usize,
+    pub visible_patches: usize,
+    pub new_patches: usize,
+    /// New patches influenced by rivers (computed by the kernel this frame).
+    pub river_patches: usize,
+    /// Visible patches drawn with an ancestor's data because theirs has not arrived yet.
+    pub fallback_patches: usize,
+    /// Patches still waiting for data after this frame.
+    pub pending_patches: usize,
+    /// The finest level drawn with its own data.
+    pub deepest_level: u32,
+    pub samples: usize,
+    pub resident_patches: usize,
+    pub evicted_patches: usize,
+    pub patch_texture_bytes: u64,
+    pub temporary_sample_bytes: u64,
+    pub precomputed_height_bytes: u64,
+    pub memory_bytes: u64,
+    pub cpu_ms: BTreeMap<String, f64>,
+    pub gpu_ms: BTreeMap<String, f64>,
+    pub frame_ms: f64,
+}
+
+/// Bytes of the largest resident patch: its base-height texture and a river texture.
+fn max_patch_bytes(n: u32) -> usize {
+    let side = crate::planet::detail::PatchHeights::side(n);
+    side * side * 4 + (n * n) as usize * 16 * crate::kernel::gpu::RIVER_TEXTURE_LAYERS as usize
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// The renderer of one planet.
+pub struct Renderer<'w> {
+    ctx: &'w Context,
+    planet: &'w Planet,
+    network: &'w RiverNetwork,
+    config: Config,
+    bindless: Bindless,
+    kernel: RiverKernel,
+    refiner: HeightRefiner,
+    terrain: GraphicsPipeline,
+    water: GraphicsPipeline,
+    wireframe: GraphicsPipeline,
+    instance_layout: BufferSetLayout,
+    /// Bound in place of a capture buffer when vertices are not captured.
+    no_capture: Buffer,
+    indices: Buffer,
+    quadrant_ranges: [std::ops::Range<u32>; 4],
+    all_indices: std::ops::Range<u32>,
+    cache: PatchCache,
+    profiler: Profiler,
+    params: KernelParams,
+    heights: HeightRange,
+    frame: u64,
+    frozen: Option<Vec<Selected>>,
+    /// GPU milliseconds per new patch (base heights and river data), averaged over recent frames: what the
+    /// generation budget divides by.
+    generation_ms_per_patch: Option<f64>,
+    pub variant: KernelVariant,
+    pub water_mode: WaterMode,
+    pub view_mode: ViewMode,
+    pub wireframe_on: bool,
+    pub freeze_lod: bool,
+    /// Beyond the thesis: patches selected by their nearest point and morphed towards their parent before a
+    /// switch (CDLOD); `false`: the thesis's Eq. 6.1 on patch centres and instant switching.
+    pub morphing: bool,
+    /// Unit direction towards the sun; `None`: over the camera's shoulder.
+    pub sun: Option<DVec3>,
+    /// Keep each frame's kernel input in `last_batch` (for benchmarks that rerun it through every variant).
+    pub capture_batches: bool,
+    /// The last frame's new river patches: (vertex spacing, samples).
+    pub last_batch: Vec<(f32, Vec<RiverSample>)>,
+    /// Record where the terrain pass put every vertex in `last_capture` (tests of precision and morphing).
+    pub capture_vertices: bool,
+    pub last_capture: Option<VertexCapture>,
+}
+
+impl<'w> Renderer<'w> {
+    pub fn new(
+        ctx: &'w Context,
+        planet: &'w Planet,
+        network: &'w RiverNetwork,
+        config: &Config,
+        color_format: vk::Format,
+        depth_format: vk::Format,
+    ) -> Result<Self, GpuError> {
+        let n = config.rendering.vertices;
+        // Resident patches: as many as the memory budget holds at the largest patch (base heights and river data),
+        // at most max-resident-patches.
+        let memory = config.rendering.resident_memory_mb as usize * 1024 * 1024;
+        let capacity =
+            (config.rendering.max_resident_patches as usize).min(memory / max_patch_bytes(n));
+        let bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
+        // Two slots per patch at most; keep the cache within what the bindless arrays hold.
+        let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
+        let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
+        let refiner = HeightRefiner::new(ctx, &bindless, n)?;
+        let instance_layout = BufferSetLayout::new(ctx, 2, "patch instances and vertex capture")?;
+        let no_capture = ctx.create_buffer(&BufferDesc {
+            name: "no vertex capture",
+            size: 16,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        let layouts = [bindless.layout, instance_layout.layout];
+        // The terrain is drawn per quadrant without a geometry shader; the water pass has the geometry shader that
+        // spawns water triangles (docs/rendering.md).
+        let pipeline = |name: &str, water: bool, wireframe: bool| {
+            GraphicsPipeline::new(
+                ctx,
+                &GraphicsDesc {
+                    name,
+                    vertex: shaders::TERRAIN_VERT,
+                    geometry: water.then_some(shaders::TERRAIN_GEOM),
+                    fragment: shaders::TERRAIN_FRAG,
+                    set_layouts: &layouts,
+                    push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+                    specialization: &[water as u32],
+                    color_format,
+                    depth_format,
+                    depth_write: !water,
+                    depth_test: true,
+                    alpha_blend: water,
+                    wireframe,
+                },
+            )
+        };
+        let terrain = pipeline("terrain", false, false)?;
+        let water = pipeline("water", true, false)?;
+        let wireframe = pipeline("terrain wireframe", false, true)?;
+        let PatchMesh {
+            indices: mesh,
+            quadrants,
+        } = patch_mesh(n);
+        let indices = ctx.create_buffer(&BufferDesc {
+            name: "patch mesh indices",
+            size: (mesh.len() * 4) as u64,
+            usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        ctx.run_and_wait("upload patch mesh", |rec| {
+            rec.upload_buffer(&indices, 0, bytemuck::cast_slice(&mesh))
+        })?;
+        let profiler = Profiler::new(ctx, 8, "frame timestamps")?;
+        // Culling bounds: every height any level can reach (finer levels add at most a bound to the precomputed
+        // range), with a river basin's depth and a unit of margin either way.
+        let (lowest, highest) = planet.height_bounds();
+        let margin = config.river.basin_depth as f64 + 1.0;
+        let heights = HeightRange {
+            min: lowest as f64 - margin,
+            max: highest as f64 + margin,
+        };
+        Ok(Self {
+            ctx,
+            planet,
+            network,
+            config: config.clone(),
+            bindless,
+            kernel,
+            refiner,
+            terrain,
+            water,
+            wireframe,
+            instance_layout,
+            no_capture,
+            indices,
+            quadrant_ranges: quadrants,
+            all_indices: 0..mesh.len() as u32,
+            cache: PatchCache::new(capacity),
+            profiler,
+            params: KernelParams::from_config(config),
+            heights,
+            frame: 0,
+            frozen: None,
+            generation_ms_per_patch: None,
+            variant: KernelVariant::Tiled,
+            water_mode: WaterMode::Auto,
+            view_mode: ViewMode::Shaded,
+            wireframe_on: false,
+            freeze_lod: false,
+            morphing: true,
+            sun: None,
+            capture_batches: false,
+            last_batch: Vec::new(),
+            capture_vertices: false,
+            last_capture: None,
+        })
+    }
+
+    /// Renders one frame into `target`, whose colour image is in `color_layouts.0` and is left in
+    /// `color_layouts.1`. `waits` and `signals` are binary semaphores (swapchain). Blocks until the frame is done.
+    pub fn render(
+        &mut self,
+        camera: &Camera,
+        target: &RenderTarget,
+        color_layouts: (vk::ImageLayout, vk::ImageLayout),
+        waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+        signals: &[vk::Semaphore],
+    ) -> Result<FrameStats, GpuError> {
+        let start = Instant::now();
+        let ctx = self.ctx;
+        self.frame += 1;
+        self.cache.next_frame();
+        let mut stats = FrameStats {
+            frame: self.frame,
+            ..Default::default()
+        };
+        let mut cpu = BTreeMap::new();
+        let n = self.config.rendering.vertices;
+
+        let visible = self.visible_patches(camera, &mut stats, &mut cpu);
+        let plan = self.plan_streaming(camera, &visible, &mut stats)?;
+
+        let t = Instant::now();
+        let prepared = self.prepare(&plan);
+        cpu.insert("influence+samples".to_string(), ms_since(t));
+        stats.samples = prepared.iter().map(|p| p.samples.len()).sum();
+
+        let t = Instant::now();
+        let mut rec = Recorder::begin(ctx, "frame")?;
+        self.profiler.reset(ctx);
+        let uploaded = self.upload_new_patches(&mut rec, &prepared)?;
+        stats.temporary_sample_bytes = uploaded.bytes;
+        stats.river_patches = uploaded.river_patches;
+        let drawn = self.record_draw(
+            &mut rec,
+            camera,
+            &visible,
+            (target, color_layouts),
+            &mut stats,
+        )?;
+        cpu.insert("record".to_string(), ms_since(t));
+
+        let t = Instant::now();
+        let id = rec.submit_with(waits, signals)?;
+        ctx.wait(id)?;
+        cpu.insert("gpu wait".to_string(), ms_since(t));
+        self.last_capture = drawn.read_capture(ctx, camera.position, n);
+        if let Some(ranges) = uploaded.ranges {
+            for (patch, range) in ranges.read(ctx)? {
+                self.cache.set_height_range(&patch, range);
+            }
+        }
+        for scope in self.profiler.read(ctx)? {
+            *stats.gpu_ms.entry(scope.name).or_default() += scope.ms;
+        }
+        self.measure_generation(&stats);
+        stats.resident_patches = self.cache.len();
+        stats.patch_texture_bytes = self.cache.bytes();
+        stats.precomputed_height_bytes = self.planet.lattice.bytes();
+        stats.memory_bytes = stats.patch_texture_bytes
+            + stats.temporary_sample_bytes
+            + stats.precomputed_height_bytes;
+        stats.cpu_ms = cpu;
+        stats.frame_ms = ms_since(start);
+        log::debug!(
+            "frame {}: {} selected, {} visible, {} new, {} pending, {} resident, deepest level {}, {:.1} ms",
+            stats.frame,
+            stats.selected_patches,
+            stats.visible_patches,
+            stats.new_patches,
+            stats.pending_patches,
+            stats.resident_patches,
+            stats.deepest_level,
+            stats.frame_ms
+        );
+        Ok(stats)
+    }
+
+    /// A free bindless slot, evicting the least recently used patches if none is left.
+    fn slot(&mut self) -> Result<Slot, GpuError> {
+        if let Some(s) = self.bindless.allocate() {
+            return Ok(s);
+        }
+        let capacity = self.cache.capacity;
+        self.cache.evict_to(capacity, self.ctx, &mut self.bindless);
+        self.bindless.allocate().ok_or_else(|| {
+            GpuError::Invalid(format!(
+                "all {} bindless slots are in use; raise max-resident-patches or lower new-patches-per-frame",
+                self.bindless.capacity
+            ))
+        })
+    }
+
+    /// Frees every GPU object of the renderer (after the device is idle).
+    pub fn destroy(mut self) {
+        let ctx = self.ctx;
+        let _ = ctx.wait_idle();
+        self.cache.clear(ctx, &mut self.bindless);
+        ctx.retire_buffer(self.indices);
+        self.profiler.destroy(ctx);
+        self.kernel.destroy(ctx);
+        self.refiner.destroy(ctx);
+        self.terrain.destroy(ctx);
+        self.water.destroy(ctx);
+        self.wireframe.destroy(ctx);
+        self.instance_layout.destroy(ctx);
+        ctx.retire_buffer(self.no_capture);
+        let _ = ctx.wait_idle();
+        self.bindless.destroy(ctx);
+    }
+}

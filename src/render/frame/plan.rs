@@ -1,0 +1,177 @@
+//! The streaming plan of a frame: which patches to draw (level of detail, Section 6.2.1, and culling, 6.2.2) and
+//! which get their data this frame (roots first, then coarse before fine and nearest first, each after the
+//! ancestors it is refined from, within the count and GPU-time budgets; the rest draw an ancestor meanwhile).
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use super::{ms_since, FrameStats, Renderer};
+use crate::{
+    gpu::GpuError,
+    planet::cube::PatchId,
+    refine::with_ancestors,
+    runtime::{
+        camera::Camera,
+        cull::{beyond_horizon, bounding_sphere, Frustum},
+        lod::{select, select_nearest, surface_bounds, LodParams, Selected},
+    },
+};
+
+impl Renderer<'_> {
+    pub(super) fn lod_params(&self) -> LodParams {
+        LodParams {
+            radius: self.planet.radius,
+            switch_factor: self.config.rendering.level_of_detail_switch_factor as f64,
+            max_level: self.config.rendering.max_level_of_detail,
+        }
+    }
+
+    /// The patches to draw: the level of detail's selection (or the frozen one), less those beyond the horizon or
+    /// outside the frustum.
+    pub(super) fn visible_patches(
+        &mut self,
+        camera: &Camera,
+        stats: &mut FrameStats,
+        cpu: &mut BTreeMap<String, f64>,
+    ) -> Vec<Selected> {
+        let radius = self.planet.radius;
+        // Section 6.2.1: level of detail (or the frozen selection).
+        let t = Instant::now();
+        let selected = match (&self.frozen, self.freeze_lod) {
+            (Some(frozen), true) => frozen.clone(),
+            _ if self.morphing => {
+                let depth = self.config.river.basin_depth as f64;
+                let cache = &self.cache;
+                select_nearest(camera.position, &self.lod_params(), &|p| {
+                    let nearest = cache
+                        .nearest_resident(p)
+                        .map(|(q, data)| (q.level, data.surface_range()));
+                    surface_bounds(self.planet, depth, p, nearest)
+                })
+            }
+            _ => select(camera.position, &self.lod_params()),
+        };
+        self.frozen = Some(selected.clone());
+        cpu.insert("lod".to_string(), ms_since(t));
+
+        // Section 6.2.2: horizon and frustum culling.
+        let t = Instant::now();
+        let frustum = Frustum::from_matrix(camera.clip());
+        let visible: Vec<Selected> = selected
+            .iter()
+            .filter(|s| {
+                let (centre, r) = bounding_sphere(s.patch, radius, self.heights);
+                !beyond_horizon(s.patch, camera.position, radius, self.heights)
+                    && frustum.touches_sphere(centre, r)
+            })
+            .copied()
+            .collect();
+        cpu.insert("cull".to_string(), ms_since(t));
+        stats.selected_patches = selected.len();
+        stats.visible_patches = visible.len();
+
+        visible
+    }
+
+    /// How many new patches this frame may make: `new-patches-per-frame`, and no more than the measured GPU time
+    /// per patch lets fit in `generation-budget-ms` (at least one, so streaming never stops).
+    fn generation_budget(&self) -> usize {
+        let count = self.config.rendering.new_patches_per_frame as usize;
+        match self.generation_ms_per_patch {
+            Some(ms) if ms > 0.0 => {
+                let fits =
+                    (self.config.rendering.generation_budget_ms as f64 / ms).floor() as usize;
+                count.min(fits.max(1))
+            }
+            _ => count,
+        }
+    }
+
+    /// Folds a frame's GPU time for making patches into the average per patch (exponential, a quarter per frame).
+    pub(super) fn measure_generation(&mut self, stats: &FrameStats) {
+        if stats.new_patches == 0 {
+            return;
+        }
+        let ms: f64 = ["heights", "kernel"]
+            .iter()
+            .filter_map(|scope| stats.gpu_ms.get(*scope))
+            .sum();
+        let sample = ms / stats.new_patches as f64;
+        self.generation_ms_per_patch = Some(match self.generation_ms_per_patch {
+            Some(average) => 0.75 * average + 0.25 * sample,
+            None => sample,
+        });
+    }
+
+    /// The patches that get their data this frame, parents before children; evicts what makes room for them.
+    pub(super) fn plan_streaming(
+        &mut self,
+        camera: &Camera,
+        visible: &[Selected],
+        stats: &mut FrameStats,
+    ) -> Result<Vec<PatchId>, GpuError> {
+        let ctx = self.ctx;
+        let radius = self.planet.radius;
+        // Patches without data: roots first (they stand in for everything), then coarse before fine and nearest
+        // first, each after the ancestors it is refined from, within the per-frame budget; the rest draw an
+        // ancestor until their turn.
+        let roots: Vec<PatchId> = (0..6).map(PatchId::root).collect();
+        let mut wanted: Vec<PatchId> = visible
+            .iter()
+            .map(|s| s.patch)
+            .filter(|p| p.level > 0 && !self.cache.contains(p))
+            .collect();
+        wanted.sort_by(|a, b| {
+            let distance = |p: &PatchId| camera.position.distance_squared(p.center() * radius);
+            (a.level, distance(a))
+                .partial_cmp(&(b.level, distance(b)))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        wanted.dedup();
+        let precomputed = self.planet.precomputed_level;
+        let forced = with_ancestors(&roots, precomputed, |p| self.cache.contains(p)).len();
+        let mut missing = with_ancestors(
+            &roots.iter().chain(&wanted).copied().collect::<Vec<_>>(),
+            precomputed,
+            |p| self.cache.contains(p),
+        );
+        // Mark what this frame draws from (its own data or a stand-in), and the resident parents that new patches
+        // are refined from, so that eviction leaves them; then make room: the cache never holds more than its
+        // budget, so at most that many patches get data.
+        for s in visible {
+            let source = if self.cache.contains(&s.patch) {
+                Some(s.patch)
+            } else {
+                self.cache.resident_ancestor(s.patch)
+            };
+            if let Some(source) = source {
+                self.cache.touch(&source);
+            }
+        }
+        let budget = self.generation_budget();
+        missing.truncate((forced + budget).min(self.cache.capacity));
+        for p in &missing {
+            if let Some(parent) = p.parent() {
+                self.cache.touch(&parent);
+            }
+        }
+        let requested = wanted.len();
+        stats.evicted_patches =
+            self.cache
+                .evict_to(self.cache.capacity - missing.len(), ctx, &mut self.bindless);
+        let room = self.cache.capacity.saturating_sub(self.cache.len());
+        missing.truncate(room.max(forced));
+        log::trace!(
+            "plan: {} wanted, budget {budget} ({:?} ms a patch), capacity {}, room {room}, forced {forced}, making {}",
+            wanted.len(),
+            self.generation_ms_per_patch,
+            self.cache.capacity,
+            missing.len()
+        );
+        stats.new_patches = missing.len().saturating_sub(forced);
+        stats.pending_patches =
+            requested.saturating_sub(missing.iter().filter(|p| wanted.contains(p)).count());
+
+        Ok(missing)
+    }
+}
