@@ -83,6 +83,9 @@ enum Command {
         flight_stress: PathBuf,
         #[arg(long)]
         long_flight: Option<PathBuf>,
+        /// Reports of `bench flight --descent` (repeat the option for several).
+        #[arg(long)]
+        descent: Vec<PathBuf>,
         /// A file with the commands that made the reports (quoted in the document).
         #[arg(long)]
         commands: PathBuf,
@@ -123,6 +126,10 @@ struct RenderArgs {
     view: ViewMode,
     #[arg(long, value_enum, default_value = "tiled")]
     kernel: riverplanet::kernel::gpu::KernelVariant,
+    /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching, instead of nearest-point
+    /// selection with morphing.
+    #[arg(long)]
+    no_morphing: bool,
     #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06")]
     clear_color: glam::DVec3,
     /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
@@ -201,6 +208,12 @@ enum BenchCommand {
         /// With --descent: write the frames whose hole check fails to DIR/holes-FRAME.png.
         #[arg(long, requires = "descent")]
         hole_images: Option<PathBuf>,
+        /// With --descent: write every tenth frame (those checked for holes) to DIR/frame-FRAME.png.
+        #[arg(long, requires = "descent")]
+        frame_images: Option<PathBuf>,
+        /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching.
+        #[arg(long)]
+        no_morphing: bool,
         #[arg(long, default_value_t = 300)]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).
@@ -285,6 +298,7 @@ fn main() -> ExitCode {
             flight,
             flight_stress,
             long_flight,
+            descent,
             commands,
             out,
         } => {
@@ -295,6 +309,7 @@ fn main() -> ExitCode {
                 flight: &flight,
                 flight_stress: &flight_stress,
                 long_flight: long_flight.as_deref(),
+                descents: &descent,
                 commands: &commands,
             };
             match bench::report::results_markdown(&inputs).map(|md| std::fs::write(&out, md)) {
@@ -485,6 +500,8 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             stress,
             descent,
             hole_images,
+            frame_images,
+            no_morphing,
             frames,
             speed,
             size,
@@ -496,6 +513,10 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
         } => {
             use std::io::IsTerminal;
             let config = load_config(&config)?;
+            for dir in hole_images.iter().chain(&frame_images) {
+                std::fs::create_dir_all(dir)
+                    .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+            }
             let world = riverplanet::world::World::build(&config, seed)?;
             let ctx = Context::new(options)?;
             let bar = std::io::stderr()
@@ -510,6 +531,8 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 compare_water_modes: !no_water_comparison,
                 descent,
                 hole_images,
+                frame_images,
+                morphing: !no_morphing,
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {
@@ -764,6 +787,7 @@ fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     renderer.water_mode = args.water;
     renderer.view_mode = args.view;
     renderer.variant = args.kernel;
+    renderer.morphing = !args.no_morphing;
     let altitude = eye.length() - config.planet.radius as f64;
     let camera = riverplanet::runtime::camera::Camera::look_at(
         eye,

@@ -107,6 +107,8 @@ pub struct FlightReport {
     pub threads: Threads,
     pub stress: bool,
     pub descent: bool,
+    pub morphing: bool,
+    pub radius: f64,
     pub seed: u32,
     pub resolution: [u32; 2],
     pub switch_factor: f32,
@@ -133,6 +135,10 @@ pub struct FlightOptions {
     pub descent: bool,
     /// Where to write the images of frames the hole check fails on (`holes-FRAME.png`).
     pub hole_images: Option<std::path::PathBuf>,
+    /// Nearest-point selection with morphing (`false`: the thesis's Eq. 6.1 and instant switching).
+    pub morphing: bool,
+    /// Where to write every checked frame of the descent (`frame-FRAME.png`, with its altitude in the report).
+    pub frame_images: Option<std::path::PathBuf>,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -164,6 +170,7 @@ fn fly(
         DEPTH_FORMAT,
     )?;
     renderer.water_mode = water;
+    renderer.morphing = options.morphing;
     renderer.capture_batches = runner.is_some();
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
@@ -410,6 +417,8 @@ pub fn flight_bench(
         threads: Threads::current(),
         stress: options.stress,
         descent: options.descent,
+        morphing: options.morphing,
+        radius: world.planet.radius,
         seed: world.seed,
         resolution: options.size,
         switch_factor: config.rendering.level_of_detail_switch_factor,

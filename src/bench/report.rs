@@ -29,6 +29,8 @@ pub struct ReportInputs<'a> {
     pub flight: &'a Path,
     pub flight_stress: &'a Path,
     pub long_flight: Option<&'a Path>,
+    /// Reports of `bench flight --descent` (any number: planets, thesis mode).
+    pub descents: &'a [std::path::PathBuf],
     /// The command lines that made the inputs, for the record.
     pub commands: &'a str,
 }
@@ -272,6 +274,39 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             f(&s["max_patch_texture_bytes"]) / 1e6,
             f(&s["max_memory_bytes"]) / 1e6,
         );
+    }
+    if !inputs.descents.is_empty() {
+        let _ = writeln!(
+            w,
+            "## The descent to the ground\n\nBeyond the thesis: `bench flight --descent` from three radii out to 2 world \
+             units above the first river's water (60 % of the frames), then turning a quarter round there; every tenth \
+             frame is checked for holes (docs/rendering.md). Frame times include waiting for the GPU.\n\n\
+             | report | planet radius | morphing | frames | deepest level | peak memory | frame ms median | max after 10 frames | max / median | hole pixels (frames checked) |\n\
+             |---|---|---|---|---|---|---|---|---|---|"
+        );
+        for path in inputs.descents {
+            let d = read(path)?;
+            let s = &d["summary"];
+            let _ =
+                writeln!(
+                w,
+                "| {} | {} | {} | {} at {}x{} | {} | {:.1} MB | {:.1} | {:.1} | {:.2} | {} ({}) |",
+                path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+                d["radius"],
+                if d["morphing"].as_bool().unwrap_or(true) { "yes" } else { "no (thesis)" },
+                s["frames"],
+                d["resolution"][0],
+                d["resolution"][1],
+                s["deepest_level"],
+                f(&s["peak_memory_bytes"]) / 1e6,
+                f(&s["frame_ms_median"]),
+                f(&s["frame_ms_max_after_warmup"]),
+                f(&s["frame_ms_max_after_warmup"]) / f(&s["frame_ms_median"]),
+                s["hole_pixels"],
+                s["hole_checked_frames"],
+            );
+        }
+        let _ = writeln!(w);
     }
     let _ = writeln!(
         w,

@@ -408,6 +408,7 @@ impl App<'_> {
                 }
             }
             KeyCode::KeyZ => renderer.freeze_lod = !renderer.freeze_lod,
+            KeyCode::KeyO => renderer.morphing = !renderer.morphing,
             KeyCode::KeyK => {
                 renderer.variant = match renderer.variant {
                     KernelVariant::Simple => KernelVariant::Tiled,
