@@ -221,11 +221,17 @@ fn fly(
             let hole_pixels = if options.descent && frame % HOLE_CHECK_EVERY == 0 {
                 let image = target.read(ctx)?;
                 let holes = hole_pixels(&image, &camera, inner).0;
-                if let (true, Some(dir)) = (holes > 0, &options.hole_images) {
-                    let path = dir.join(format!("holes-{frame}.png"));
+                let save = |dir: &std::path::Path, name: String| {
+                    let path = dir.join(name);
                     image.save(&path).map_err(|e| {
                         GpuError::Invalid(format!("cannot write {}: {e}", path.display()))
-                    })?;
+                    })
+                };
+                if let (true, Some(dir)) = (holes > 0, &options.hole_images) {
+                    save(dir, format!("holes-{frame:03}.png"))?;
+                }
+                if let Some(dir) = &options.frame_images {
+                    save(dir, format!("frame-{frame:03}.png"))?;
                 }
                 Some(holes)
             } else {
