@@ -799,23 +799,12 @@ fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     let c = args.clear_color;
     let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
     let mut layout = gpu::vk::ImageLayout::UNDEFINED;
-    let mut frames = 0;
-    let stats = loop {
-        let stats = renderer.render(
-            &camera,
-            &target.target(clear),
-            (layout, gpu::vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-            &[],
-            &[],
-        )?;
-        layout = gpu::vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-        frames += 1;
-        if (stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0)
-            || frames >= args.max_frames
-        {
-            break stats;
-        }
-    };
+    let (stats, frames) = renderer.render_until_streamed(
+        &camera,
+        &target.target(clear),
+        &mut layout,
+        args.max_frames,
+    )?;
     let image = target.read(&ctx)?;
     image
         .save(&args.out)

@@ -129,22 +129,15 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
         let eye = up * (ground + altitude) + side * altitude * 0.5;
         let camera = Camera::look_at(eye, up * ground, 60.0, 16.0 / 9.0, altitude * 0.05);
         // Stream until every visible patch has its own data, then capture.
-        for _ in 0..50 {
-            renderer.capture_vertices = false;
-            let stats = renderer
-                .render(
-                    &camera,
-                    &offscreen.target([0.0, 0.0, 0.0, 1.0]),
-                    (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                    &[],
-                    &[],
-                )
-                .unwrap();
-            layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-            if stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0 {
-                break;
-            }
-        }
+        renderer.capture_vertices = false;
+        renderer
+            .render_until_streamed(
+                &camera,
+                &offscreen.target([0.0, 0.0, 0.0, 1.0]),
+                &mut layout,
+                50,
+            )
+            .unwrap();
         renderer.capture_vertices = true;
         renderer
             .render(

@@ -67,39 +67,26 @@ fn two_metres_above_an_earth_sized_river_vertices_are_exact_to_a_millimetre_and_
         DEPTH_FORMAT,
     )
     .unwrap();
+    let target = offscreen.target([0.0, 0.0, 0.0, 1.0]);
     let mut layout = vk::ImageLayout::UNDEFINED;
-    let mut frame = |renderer: &mut Renderer, camera: &Camera, capture: bool| {
+    // `frames` frames at most, until every visible patch has its data.
+    let mut frame = |renderer: &mut Renderer, camera: &Camera, capture: bool, frames: u32| {
         renderer.capture_vertices = capture;
-        let stats = renderer
-            .render(
-                camera,
-                &offscreen.target([0.0, 0.0, 0.0, 1.0]),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )
+        let (stats, _) = renderer
+            .render_until_streamed(camera, &target, &mut layout, frames)
             .unwrap();
-        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
         stats
     };
     let camera_at =
         |offset: DVec3| Camera::look_at(eye + offset, look_at + offset, 60.0, 16.0 / 9.0, 0.1);
     let here = camera_at(DVec3::ZERO);
-    let mut streamed = false;
-    for _ in 0..60 {
-        let stats = frame(&mut renderer, &here, false);
-        streamed =
-            stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0;
-        if streamed {
-            break;
-        }
-    }
+    let streamed = frame(&mut renderer, &here, false, 60).streamed();
     assert!(streamed, "patch data still streaming after 60 frames");
-    let deepest = frame(&mut renderer, &here, true).deepest_level;
+    let deepest = frame(&mut renderer, &here, true, 1).deepest_level;
     let before = renderer.last_capture.take().unwrap();
     // One centimetre sideways.
     let side = (look_at - eye).cross(eye).normalize() * 0.01;
-    frame(&mut renderer, &camera_at(side), true);
+    frame(&mut renderer, &camera_at(side), true, 1);
     let after = renderer.last_capture.take().unwrap();
     renderer.destroy();
     offscreen.destroy(ctx);

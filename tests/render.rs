@@ -187,21 +187,9 @@ fn render_with(
     .unwrap();
     setup(&mut renderer);
     let mut layout = vk::ImageLayout::UNDEFINED;
-    for _ in 0..100 {
-        let stats = renderer
-            .render(
-                camera,
-                &target.target(CLEAR),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )
-            .unwrap();
-        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-        if stats.pending_patches == 0 && stats.fallback_patches == 0 && stats.new_patches == 0 {
-            break;
-        }
-    }
+    renderer
+        .render_until_streamed(camera, &target.target(CLEAR), &mut layout, 100)
+        .unwrap();
     let image = target.read(ctx).unwrap();
     renderer.destroy();
     target.destroy(ctx);

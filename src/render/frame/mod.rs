@@ -103,6 +103,13 @@ fn max_patch_bytes(n: u32) -> usize {
     side * side * 4 + (n * n) as usize * 16 * crate::kernel::gpu::RIVER_TEXTURE_LAYERS as usize
 }
 
+impl FrameStats {
+    /// Whether every visible patch was drawn with its own data and nothing is left to make.
+    pub fn streamed(&self) -> bool {
+        self.pending_patches == 0 && self.fallback_patches == 0 && self.new_patches == 0
+    }
+}
+
 fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -263,6 +270,34 @@ impl<'w> Renderer<'w> {
             capture_vertices: false,
             last_capture: None,
         })
+    }
+
+    /// Renders frames of `camera` into `target` until every visible patch has its own data (or `max_frames` were
+    /// rendered): what a still image needs. The colour image is in `*layout` and is left in
+    /// COLOR_ATTACHMENT_OPTIMAL (`*layout` says so afterwards). Returns the last frame's statistics and the number
+    /// of frames.
+    pub fn render_until_streamed(
+        &mut self,
+        camera: &Camera,
+        target: &RenderTarget,
+        layout: &mut vk::ImageLayout,
+        max_frames: u32,
+    ) -> Result<(FrameStats, u32), GpuError> {
+        let mut frames = 0;
+        loop {
+            let stats = self.render(
+                camera,
+                target,
+                (*layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                &[],
+                &[],
+            )?;
+            *layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+            frames += 1;
+            if stats.streamed() || frames >= max_frames {
+                return Ok((stats, frames));
+            }
+        }
     }
 
     /// Renders one frame into `target`, whose colour image is in `color_layouts.0` and is left in
