@@ -205,6 +205,88 @@ impl FaceLattice {
             self.at_key(key * scale)
         })
     }
+
+    /// The whole planet at `level` as one lattice per face, assembled from every patch of that level refined
+    /// patch by patch from this lattice (of level `own_level`), as the renderer makes them; a sub-sampling for
+    /// levels no finer than this one.
+    pub fn refined_to(&self, own_level: u32, level: u32, rule: &DetailRule, n: u32) -> FaceLattice {
+        let cells = (n - 1) << level;
+        let mut out = FaceLattice::new(cells, 0.0);
+        let fill = |out: &mut FaceLattice, p: &PatchHeights| {
+            let (x0, y0) = detail::origin(p.patch, n);
+            for j in 0..n as i64 {
+                for i in 0..n as i64 {
+                    let index = out.index(p.patch.face as usize, (x0 + i) as u32, (y0 + j) as u32);
+                    out.data[index] = p.get(i, j);
+                }
+            }
+        };
+        let start = level.min(own_level);
+        for face in 0..FACES {
+            let count = 1u32 << start;
+            let mut patches: Vec<PatchHeights> = (0..count * count)
+                .map(|k| PatchId {
+                    face: face as u8,
+                    level: start as u8,
+                    x: k % count,
+                    y: k / count,
+                })
+                .map(|p| self.patch_heights(p, n))
+                .collect();
+            for _ in start..level {
+                patches = patches
+                    .par_iter()
+                    .flat_map_iter(|parent| {
+                        (0..4).map(move |q| detail::refine(parent, parent.patch.child(q), rule))
+                    })
+                    .collect();
+            }
+            for p in &patches {
+                fill(&mut out, p);
+            }
+        }
+        out
+    }
+
+    /// The height range of every patch of levels 0..=`top`, from the lattice of level `top`: level `top` with its
+    /// border (what its descendants are refined from), coarser levels as the union of their children (which holds
+    /// every vertex of theirs).
+    pub fn patch_bounds_pyramid(&self, top: u32, n: u32) -> Vec<Vec<(f32, f32)>> {
+        let count = 1u32 << top;
+        let finest: Vec<(f32, f32)> = (0..FACES as u32 * count * count)
+            .into_par_iter()
+            .map(|k| {
+                let patch = PatchId {
+                    face: (k / (count * count)) as u8,
+                    level: top as u8,
+                    x: k % count,
+                    y: (k / count) % count,
+                };
+                self.patch_heights(patch, n).range()
+            })
+            .collect();
+        let mut levels = vec![finest];
+        for level in (0..top).rev() {
+            let count = 1usize << level;
+            let finer = levels.last().expect("the finest level is there");
+            let coarse: Vec<(f32, f32)> = (0..FACES * count * count)
+                .map(|k| {
+                    let (face, y, x) = (k / (count * count), (k / count) % count, k % count);
+                    (0..4)
+                        .map(|q| {
+                            let (cx, cy) = (2 * x + (q & 1), 2 * y + (q >> 1));
+                            finer[(face * 2 * count + cy) * 2 * count + cx]
+                        })
+                        .fold((f32::MAX, f32::MIN), |(lo, hi), (a, b)| {
+                            (lo.min(a), hi.max(b))
+                        })
+                })
+                .collect();
+            levels.push(coarse);
+        }
+        levels.reverse();
+        levels
+    }
 }
 
 /// Area on the unit sphere represented by lattice point (i, j) of one face: the gnomonic Jacobian times the

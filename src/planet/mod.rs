@@ -281,7 +281,7 @@ impl Planet {
         mut stats: PlanetStats,
     ) -> Self {
         stats.mountains = mountains.len();
-        let bounds = patch_bounds_pyramid(&lattice, precomputed_level, config.rendering.vertices);
+        let bounds = lattice.patch_bounds_pyramid(precomputed_level, config.rendering.vertices);
         stats.memory_bytes = lattice.bytes();
         log::info!("planet: {stats:?}");
         Self {
@@ -358,85 +358,9 @@ impl Planet {
     /// precomputed lattice, or assembled from every patch of that level, made level by level from their
     /// parents as the renderer makes them.
     pub fn face_lattice(&self, level: u32) -> FaceLattice {
-        let n = self.vertices;
-        let cells = (n - 1) << level;
-        let mut out = FaceLattice::new(cells, 0.0);
-        let fill = |out: &mut FaceLattice, p: &PatchHeights| {
-            let (x0, y0) = detail::origin(p.patch, n);
-            for j in 0..n as i64 {
-                for i in 0..n as i64 {
-                    let index = out.index(p.patch.face as usize, (x0 + i) as u32, (y0 + j) as u32);
-                    out.data[index] = p.get(i, j);
-                }
-            }
-        };
-        let start = level.min(self.precomputed_level);
-        for face in 0..cube::FACES {
-            let count = 1u32 << start;
-            let mut patches: Vec<PatchHeights> = (0..count * count)
-                .map(|k| PatchId {
-                    face: face as u8,
-                    level: start as u8,
-                    x: k % count,
-                    y: k / count,
-                })
-                .map(|p| self.lattice.patch_heights(p, n))
-                .collect();
-            for _ in start..level {
-                patches = patches
-                    .par_iter()
-                    .flat_map_iter(|parent| {
-                        (0..4)
-                            .map(move |q| detail::refine(parent, parent.patch.child(q), &self.rule))
-                    })
-                    .collect();
-            }
-            for p in &patches {
-                fill(&mut out, p);
-            }
-        }
-        out
+        self.lattice
+            .refined_to(self.precomputed_level, level, &self.rule, self.vertices)
     }
-}
-
-/// The height range of every patch of levels 0..=`top`, from the lattice of level `top`: level `top` with its
-/// border (what its descendants are refined from), coarser levels as the union of their children (which holds
-/// every vertex of theirs).
-fn patch_bounds_pyramid(lattice: &FaceLattice, top: u32, n: u32) -> Vec<Vec<(f32, f32)>> {
-    let count = 1u32 << top;
-    let finest: Vec<(f32, f32)> = (0..FACES as u32 * count * count)
-        .into_par_iter()
-        .map(|k| {
-            let patch = PatchId {
-                face: (k / (count * count)) as u8,
-                level: top as u8,
-                x: k % count,
-                y: (k / count) % count,
-            };
-            lattice.patch_heights(patch, n).range()
-        })
-        .collect();
-    let mut levels = vec![finest];
-    for level in (0..top).rev() {
-        let count = 1usize << level;
-        let finer = levels.last().expect("the finest level is there");
-        let coarse: Vec<(f32, f32)> = (0..FACES * count * count)
-            .map(|k| {
-                let (face, y, x) = (k / (count * count), (k / count) % count, k % count);
-                (0..4)
-                    .map(|q| {
-                        let (cx, cy) = (2 * x + (q & 1), 2 * y + (q >> 1));
-                        finer[(face * 2 * count + cy) * 2 * count + cx]
-                    })
-                    .fold((f32::MAX, f32::MIN), |(lo, hi), (a, b)| {
-                        (lo.min(a), hi.max(b))
-                    })
-            })
-            .collect();
-        levels.push(coarse);
-    }
-    levels.reverse();
-    levels
 }
 
 /// Spreads the base lattice onto the lattice of level `to` and runs diamond-square from the base level up to it
