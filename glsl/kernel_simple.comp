@@ -1,18 +1,24 @@
 #version 460
 // Simple GPU version (7.3.1): one invocation per vertex, every sample read from the storage buffer.
-// Workgroups: x covers a patch's vertices, y selects the patch in the job table.
+// Workgroups: x covers a row's vertices, y selects the row in the job table (from params.firstJob).
 layout(local_size_x_id = 0) in;
 #include "river_kernel.glsl"
 
 void main() {
-    PatchJob job = jobs[gl_WorkGroupID.y];
-    uint vertex = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
-    if (vertex >= params.gridSize * params.gridSize) return;
-    uvec2 xy = uvec2(vertex % params.gridSize, vertex / params.gridSize);
-    vec2 v = vec2(xy) * job.spacing;
+    PatchJob job = jobs[params.firstJob + gl_WorkGroupID.y];
+    uvec2 size = latticeSize(job);
+    uint index = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+    if (index >= size.x * size.y) return;
+    uvec2 xy = uvec2(index % size.x, index / size.x);
+    if (job.parentSlot != NO_PARENT) {
+        copyFromParent(job, xy);
+        return;
+    }
+    uvec2 vertex = patchVertex(job, xy);
+    vec2 v = vec2(vertex) * job.spacing;
     Accumulators acc = initAccumulators();
     for (uint k = 0; k < job.sampleCount; ++k) {
         accumulateSample(acc, v, prepareSample(samples[job.sampleOffset + k]));
     }
-    storeHeight(acc, job, xy);
+    storeHeight(acc, job, vertex);
 }

@@ -73,16 +73,22 @@ void accumulateTile(inout Accumulators acc, vec2 v, uint staged) {
 }
 
 void main() {
-    PatchJob job = jobs[gl_WorkGroupID.z];
+    PatchJob job = jobs[params.firstJob + gl_WorkGroupID.z];
     uvec2 size = uvec2(BLOCK_X, BLOCK_Y);
-    uvec2 count = blockCount(size);
-    uint blocks = count.x * count.y;
+    uvec2 count = blockCount(job, size);
+    // The dispatch covers the largest lattice of its rows; a smaller one leaves whole workgroups idle.
+    if (any(greaterThanEqual(gl_WorkGroupID.xy, count))) return;
     uint block = gl_WorkGroupID.y * count.x + gl_WorkGroupID.x;
     uint lane = gl_LocalInvocationIndex;
     uvec2 xy = gl_WorkGroupID.xy * size + vertexInBlock(lane);
-    // Invocations beyond the grid take part in staging and in the subgroup broadcasts, and store nothing.
-    bool hasVertex = xy.x < params.gridSize && xy.y < params.gridSize;
-    vec2 v = vec2(xy) * job.spacing;
+    // Invocations beyond the lattice take part in staging and in the subgroup broadcasts, and store nothing.
+    bool hasVertex = all(lessThan(xy, latticeSize(job)));
+    if (job.parentSlot != NO_PARENT) {
+        if (hasVertex) copyFromParent(job, xy);
+        return;
+    }
+    uvec2 vertex = patchVertex(job, xy);
+    vec2 v = vec2(vertex) * job.spacing;
     uint words = wordsOf(job);
 
     // The patch's mask words are read in chunks of TILE_WORDS (invocation i holds word i of the chunk); the
@@ -93,7 +99,7 @@ void main() {
     uint filled = 0;
     for (uint chunk = 0; chunk * TILE_WORDS < words; ++chunk) {
         uint word = chunk * TILE_WORDS + lane;
-        uint bits = lane < TILE_WORDS && word < words ? reachMasks[reachMaskIndex(job, blocks, block, word)] : 0;
+        uint bits = lane < TILE_WORDS && word < words ? reachMasks[reachMaskIndex(job, block, word)] : 0;
         uint at = subgroupExclusiveAdd(bitCount(bits));
         // Counts alternate between two rows, so a chunk's counts are never overwritten before every invocation
         // has read them (the next chunk's barrier comes first).
@@ -127,5 +133,5 @@ void main() {
     // chunk's barrier, which comes before any flush.
     barrier();
     accumulateTile(acc, v, filled);
-    if (hasVertex) storeHeight(acc, job, xy);
+    if (hasVertex) storeHeight(acc, job, vertex);
 }

@@ -8,18 +8,30 @@ struct RiverSample {
     vec4 heightWidth;
 };
 
-// One patch of the dispatch: its grid spacing, its range of samples, its bindless slot, and where its reach
-// masks start (in units of words x blocks; used by the tiled kernel only, see kernel_blocks.glsl).
+// One row of the dispatch: a patch's grid spacing, its range of samples, its bindless slot, where its reach
+// masks start (in words; used by the tiled kernel only, see kernel_blocks.glsl), and which of its vertices the row
+// covers. A patch computed from scratch is one row over all its vertices. A patch that takes river data from its
+// parent (10.2, docs/kernel.md) is four rows, one per vertex parity: the even vertices copied from the parent's
+// quadrant, and the three other lattices of every second vertex computed.
 struct PatchJob {
     float spacing;
     uint sampleOffset;
     uint sampleCount;
     uint slot;
     uint maskOffset;
+    // Stride (bits 0-7) and the parity of the first vertex along x (bits 8-15) and y (16-23).
+    uint lattice;
+    // The parent's slot to copy from, or NO_PARENT.
+    uint parentSlot;
+    // The parent vertex of the row's first vertex: x (bits 0-15), y (16-31).
+    uint parentOffset;
 };
 
+const uint NO_PARENT = 0xffffffffu;
+
 // Layer 0: terrain height, lerp factor, water height, signed minimum distance. Layer 1: river half width.
-layout(set = 0, binding = 0, rgba32f) uniform writeonly image2DArray riverImages[];
+// Read as well as written: rows that copy from the parent read its texture.
+layout(set = 0, binding = 0, rgba32f) uniform image2DArray riverImages[];
 layout(set = 1, binding = 0, std430) readonly buffer Samples { RiverSample samples[]; };
 layout(set = 1, binding = 1, std430) readonly buffer Jobs { PatchJob jobs[]; };
 
@@ -29,7 +41,37 @@ layout(push_constant) uniform KernelParams {
     float seaLevel;
     float basinWaterOffset;
     uint gridSize;
+    // Row of the job table that workgroup index 0 computes: rows are dispatched in groups of the same lattice.
+    uint firstJob;
 } params;
+
+uint latticeStride(PatchJob job) {
+    return job.lattice & 0xffu;
+}
+
+uvec2 latticeParity(PatchJob job) {
+    return uvec2((job.lattice >> 8) & 0xffu, (job.lattice >> 16) & 0xffu);
+}
+
+// Vertices of the row's lattice along x and y.
+uvec2 latticeSize(PatchJob job) {
+    uint stride = latticeStride(job);
+    return (uvec2(params.gridSize) - latticeParity(job) + stride - 1) / stride;
+}
+
+// The patch vertex of lattice point `xy`.
+uvec2 patchVertex(PatchJob job, uvec2 xy) {
+    return xy * latticeStride(job) + latticeParity(job);
+}
+
+// A row that copies its lattice (every second vertex, from the first) from the parent's quadrant.
+void copyFromParent(PatchJob job, uvec2 xy) {
+    ivec2 from = ivec2(xy + uvec2(job.parentOffset & 0xffffu, job.parentOffset >> 16));
+    ivec2 to = ivec2(patchVertex(job, xy));
+    for (int layer = 0; layer < 2; ++layer) {
+        imageStore(riverImages[job.slot], ivec3(to, layer), imageLoad(riverImages[job.parentSlot], ivec3(from, layer)));
+    }
+}
 
 // The accumulators of Procedure 4.
 struct Accumulators {
@@ -102,7 +144,7 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
     }
 }
 
-// Procedure 5: the five outputs of one vertex, written to the patch's slot.
+// Procedure 5: the five outputs of one vertex (patch vertex `xy`), written to the patch's slot.
 void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
     vec4 heights = vec4(0.0, 1.0, params.seaLevel, params.influenceDistance);
     float riverWidth = 0.0;

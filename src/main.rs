@@ -176,6 +176,10 @@ enum BenchCommand {
         /// Frames of the flight that produces the workload.
         #[arg(long, default_value_t = 300)]
         frames: u32,
+        /// Compare river data taken from the parent patch (10.2) with computing from scratch, on the patches of
+        /// the descent to the ground whose parents have the rivers' final detail (use config/earth.xml).
+        #[arg(long, conflicts_with = "stress")]
+        parent_reuse: bool,
         /// Repetitions per variant (the median is reported).
         #[arg(long, default_value_t = 5)]
         repetitions: usize,
@@ -214,6 +218,9 @@ enum BenchCommand {
         /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching.
         #[arg(long)]
         no_morphing: bool,
+        /// Compute every patch's river data from scratch, as the thesis (no data from the parent, 10.2).
+        #[arg(long)]
+        no_parent_reuse: bool,
         #[arg(long, default_value_t = 300)]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).
@@ -440,6 +447,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             seed,
             stress,
             frames,
+            parent_reuse,
             repetitions,
             simple_workgroup,
             tiled_block,
@@ -454,6 +462,14 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 tiled_block: tiled_block.unwrap_or(KernelTuning::default().tiled_block),
                 tile_size,
             };
+            if parent_reuse {
+                let report = bench::reuse::reuse_bench(&ctx, &world, frames, repetitions, tuning)?;
+                print!("{}", report.summary());
+                if let Some(path) = json {
+                    write_json(&path, &report)?;
+                }
+                return Ok(());
+            }
             let report =
                 bench::kernel::kernel_bench(&ctx, &world, stress, frames, repetitions, tuning)?;
             let v = &report.variants;
@@ -502,6 +518,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             hole_images,
             frame_images,
             no_morphing,
+            no_parent_reuse,
             frames,
             speed,
             size,
@@ -533,6 +550,7 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
                 hole_images,
                 frame_images,
                 morphing: !no_morphing,
+                parent_reuse: !no_parent_reuse,
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {

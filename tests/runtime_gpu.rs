@@ -58,7 +58,9 @@ fn river_data_is_identical_alone_in_a_batch_and_after_recomputing() {
     let patches = river_patches(world);
     let samples: Vec<_> = patches
         .iter()
-        .map(|p| patch_samples(&world.network, &PatchFrame::new(*p, world.planet.radius, n)))
+        .map(|p| {
+            patch_samples(&world.network, &PatchFrame::new(*p, world.planet.radius, n)).samples
+        })
         .collect();
     assert!(
         samples.iter().all(|s| !s.is_empty()),
@@ -87,7 +89,9 @@ fn river_data_is_identical_alone_in_a_batch_and_after_recomputing() {
         // Recomputing from scratch (as after eviction): same samples, same texels, bit for bit.
         let again: Vec<_> = patches
             .iter()
-            .map(|p| patch_samples(&world.network, &PatchFrame::new(*p, world.planet.radius, n)))
+            .map(|p| {
+                patch_samples(&world.network, &PatchFrame::new(*p, world.planet.radius, n)).samples
+            })
             .collect();
         assert_eq!(again, samples);
         let reversed: Vec<PatchJob> = jobs.iter().rev().copied().collect();

@@ -108,6 +108,7 @@ pub struct FlightReport {
     pub stress: bool,
     pub descent: bool,
     pub morphing: bool,
+    pub parent_reuse: bool,
     pub radius: f64,
     pub seed: u32,
     pub resolution: [u32; 2],
@@ -137,6 +138,8 @@ pub struct FlightOptions {
     pub hole_images: Option<std::path::PathBuf>,
     /// Nearest-point selection with morphing (`false`: the thesis's Eq. 6.1 and instant switching).
     pub morphing: bool,
+    /// River data from the parent patch where it has the final detail (`false`: from scratch, as the thesis).
+    pub parent_reuse: bool,
     /// Where to write every checked frame of the descent (`frame-FRAME.png`, with its altitude in the report).
     pub frame_images: Option<std::path::PathBuf>,
 }
@@ -171,6 +174,7 @@ fn fly(
     )?;
     renderer.water_mode = water;
     renderer.morphing = options.morphing;
+    renderer.parent_reuse = options.parent_reuse;
     renderer.capture_batches = runner.is_some();
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
@@ -424,6 +428,7 @@ pub fn flight_bench(
         stress: options.stress,
         descent: options.descent,
         morphing: options.morphing,
+        parent_reuse: options.parent_reuse,
         radius: world.planet.radius,
         seed: world.seed,
         resolution: options.size,

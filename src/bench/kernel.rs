@@ -4,6 +4,7 @@
 
 use std::{collections::HashSet, time::Instant};
 
+use glam::DVec3;
 use serde::Serialize;
 
 use super::{median, path::Flight, Threads};
@@ -14,10 +15,11 @@ use crate::{
         gpu::{run_batch_into, BatchOutputs, KernelTuning, KernelVariant, RiverKernel},
         max_abs_diff, KernelParams, PatchJob, RiverSample, RiverTexel,
     },
-    river::samples::{patch_samples, PatchFrame},
+    planet::cube::PatchId,
+    river::samples::{patch_samples, PatchFrame, PatchSamples},
     runtime::{
         cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
-        lod::{select, LodParams},
+        lod::{select, LodParams, Selected},
     },
     world::World,
 };
@@ -78,26 +80,49 @@ pub struct KernelReport {
 /// The patches and samples a scripted flight produces: every visible patch that a river influences, once, in
 /// the order the flight meets them. `stress` uses the thesis's stress settings (switch factor x10, camera x25).
 pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Vec<RiverSample>)> {
+    let flight = Flight::new(world, frames, if stress { 25.0 } else { 1.0 }, 16.0 / 9.0);
+    let n = world.config.rendering.vertices;
+    let params = lod_params(world, if stress { 10.0 } else { 1.0 });
+    flight_patches(world, &flight, frames, &|camera| select(camera, &params))
+        .into_iter()
+        .map(|(patch, s)| {
+            let spacing = PatchFrame::new(patch, world.planet.radius, n).spacing() as f32;
+            (spacing, s.samples)
+        })
+        .collect()
+}
+
+/// The level-of-detail parameters of `world`, with the switch factor scaled by `switch_scale`.
+pub fn lod_params(world: &World, switch_scale: f64) -> LodParams {
+    let rendering = &world.config.rendering;
+    LodParams {
+        radius: world.planet.radius,
+        switch_factor: rendering.level_of_detail_switch_factor as f64 * switch_scale,
+        max_level: rendering.max_level_of_detail,
+    }
+}
+
+/// Every visible patch of `flight`'s first `frames` frames that a river influences, once, in the order the
+/// flight meets them; `select` picks the patches for a camera position.
+pub fn flight_patches(
+    world: &World,
+    flight: &Flight,
+    frames: u32,
+    select: &dyn Fn(DVec3) -> Vec<Selected>,
+) -> Vec<(PatchId, PatchSamples)> {
     let config = &world.config;
     let n = config.rendering.vertices;
     let radius = world.planet.radius;
-    let factor = if stress { 10.0 } else { 1.0 };
-    let params = LodParams {
-        radius,
-        switch_factor: config.rendering.level_of_detail_switch_factor as f64 * factor,
-        max_level: config.rendering.max_level_of_detail,
-    };
     let heights = HeightRange {
         min: world.planet.stats.min_height as f64 - 1.0,
         max: world.planet.stats.max_height as f64 + config.river.basin_depth as f64 + 1.0,
     };
-    let flight = Flight::new(world, frames, if stress { 25.0 } else { 1.0 }, 16.0 / 9.0);
     let mut seen = HashSet::new();
     let mut out = Vec::new();
     for frame in 0..frames {
         let camera = flight.camera(world, frame);
         let frustum = Frustum::from_matrix(camera.clip());
-        for s in select(camera.position, &params) {
+        for s in select(camera.position) {
             let (c, r) = bounding_sphere(s.patch, radius, heights);
             if beyond_horizon(s.patch, camera.position, radius, heights)
                 || !frustum.touches_sphere(c, r)
@@ -107,10 +132,9 @@ pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Ve
             if !seen.insert(s.patch) {
                 continue;
             }
-            let frame = PatchFrame::new(s.patch, radius, n);
-            let samples = patch_samples(&world.network, &frame);
-            if !samples.is_empty() {
-                out.push((frame.spacing() as f32, samples));
+            let samples = patch_samples(&world.network, &PatchFrame::new(s.patch, radius, n));
+            if !samples.samples.is_empty() {
+                out.push((s.patch, samples));
             }
         }
     }
@@ -186,7 +210,16 @@ impl VariantRunner {
         let mut gpu = |variant| -> Result<VariantTiming, GpuError> {
             let run = || {
                 let (bindless, outputs) = (&self.bindless, &self.outputs);
-                run_batch_into(ctx, bindless, &self.kernel, variant, jobs, params, outputs)
+                run_batch_into(
+                    ctx,
+                    bindless,
+                    &self.kernel,
+                    variant,
+                    jobs,
+                    &[],
+                    params,
+                    outputs,
+                )
             };
             if warm_up {
                 run()?;

@@ -9,6 +9,7 @@ pub mod kernel;
 pub mod path;
 pub mod plot;
 pub mod report;
+pub mod reuse;
 
 use serde::Serialize;
 

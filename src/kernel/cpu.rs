@@ -11,7 +11,7 @@
 
 use rayon::prelude::*;
 
-use super::{vertex_position, KernelParams, PatchJob, RiverSample, RiverTexel};
+use super::{vertex_position, KernelParams, ParentQuadrant, PatchJob, RiverSample, RiverTexel};
 
 /// What Procedure 3 returns for a relevant sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -188,6 +188,26 @@ pub fn compute_patch(job: &PatchJob, n: u32, params: &KernelParams) -> Vec<River
                 job.samples,
                 params,
             )
+        })
+        .collect()
+}
+
+/// One patch whose even vertices come from its parent's `quadrant` (`parent`: the parent's `n x n` texels), the
+/// others computed: the reference of the GPU kernels' parent reuse.
+pub fn compute_patch_from_parent(
+    job: &PatchJob,
+    parent: &[RiverTexel],
+    quadrant: ParentQuadrant,
+    n: u32,
+    params: &KernelParams,
+) -> Vec<RiverTexel> {
+    (0..n * n)
+        .map(|k| {
+            let (i, j) = (k % n, k / n);
+            match quadrant.parent_vertex(i, j) {
+                Some((pi, pj)) => parent[(pj * n + pi) as usize],
+                None => calculate_height(vertex_position(i, j, job.spacing), job.samples, params),
+            }
         })
         .collect()
 }

@@ -4,7 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use super::{KernelParams, PatchJob, RiverSample, RiverTexel};
+use super::{KernelParams, ParentQuadrant, PatchJob, RiverSample, RiverTexel};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
@@ -115,7 +115,8 @@ pub fn tiled_shared_bytes(tile_size: u32, invocations: u32) -> u32 {
     tile_size * 28 + 2 * invocations * 4
 }
 
-/// One row of the range table (std430, 20 bytes).
+/// One row of the range table (std430, 32 bytes): a patch, or for a patch that takes river data from its parent,
+/// one of its four vertex lattices (glsl/river_kernel.glsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuPatchJob {
@@ -123,15 +124,92 @@ pub struct GpuPatchJob {
     pub sample_offset: u32,
     pub sample_count: u32,
     pub slot: u32,
-    /// Mask words (one bit per sample) of the jobs before this one; the tiled kernel's reach masks of this
-    /// patch start at `mask_offset` x blocks per patch.
+    /// Mask words of the rows before this one: the tiled kernel's reach masks of this row start there.
     pub mask_offset: u32,
+    /// Stride (bits 0-7) and parity along x (bits 8-15) and y (bits 16-23) of the vertices this row covers.
+    pub lattice: u32,
+    /// The parent's slot to copy the row's vertices from, or [`NO_PARENT`].
+    pub parent_slot: u32,
+    /// The parent vertex of the row's first vertex: x (bits 0-15), y (bits 16-31).
+    pub parent_offset: u32,
 }
 
+/// `parent_slot` of a row computed by the kernel.
+pub const NO_PARENT: u32 = u32::MAX;
+
 impl GpuPatchJob {
-    /// Reach-mask words per vertex block of this patch: one bit per sample.
+    /// Reach-mask words per vertex block of this row: one bit per sample.
     pub fn mask_words(&self) -> u32 {
         self.sample_count.div_ceil(32)
+    }
+
+    /// Vertices along x and y of this row's lattice in an `n x n` patch.
+    pub fn lattice_size(&self, n: u32) -> [u32; 2] {
+        let stride = self.lattice & 0xff;
+        let parity = [(self.lattice >> 8) & 0xff, (self.lattice >> 16) & 0xff];
+        parity.map(|p| (n - p).div_ceil(stride))
+    }
+}
+
+/// The rows of a batch (patches computed from scratch first, then the four rows of each patch that takes river
+/// data from its parent) and where each patch's samples start in the sample buffer.
+pub struct RangeTable {
+    pub rows: Vec<GpuPatchJob>,
+    /// Rows over all vertices of a patch (the first ones); the rest cover every second vertex.
+    pub full_rows: usize,
+    pub sample_offsets: Vec<u32>,
+    /// Reach-mask words of all rows, with blocks of `block` vertices.
+    pub mask_words: u64,
+}
+
+/// The range table of `batch` for `n x n` patches and the tiled kernel's `block`.
+pub fn range_table(batch: &KernelBatch, n: u32, block: [u32; 2]) -> RangeTable {
+    let mut sample_offsets = Vec::with_capacity(batch.jobs.len());
+    let mut offset = 0;
+    for job in batch.jobs {
+        sample_offsets.push(offset);
+        offset += job.samples.len() as u32;
+    }
+    let parent = |k: usize| batch.parents.get(k).copied().flatten();
+    let row = |k: usize, lattice: u32, parent_slot: u32, parent_offset: u32| GpuPatchJob {
+        spacing: batch.jobs[k].spacing,
+        sample_offset: sample_offsets[k],
+        sample_count: if parent_slot == NO_PARENT {
+            batch.jobs[k].samples.len() as u32
+        } else {
+            0
+        },
+        slot: batch.slots[k].0,
+        mask_offset: 0,
+        lattice,
+        parent_slot,
+        parent_offset,
+    };
+    let mut rows: Vec<GpuPatchJob> = (0..batch.jobs.len())
+        .filter(|&k| parent(k).is_none())
+        .map(|k| row(k, 1, NO_PARENT, 0))
+        .collect();
+    let full_rows = rows.len();
+    for k in 0..batch.jobs.len() {
+        if let Some((slot, quadrant)) = parent(k) {
+            let [x, y] = quadrant.offset;
+            rows.push(row(k, 2, slot.0, x | y << 16));
+            for parity in [[1, 0], [0, 1], [1, 1]] {
+                rows.push(row(k, 2 | parity[0] << 8 | parity[1] << 16, NO_PARENT, 0));
+            }
+        }
+    }
+    let mut mask_words = 0u64;
+    for r in &mut rows {
+        r.mask_offset = mask_words as u32;
+        let [lx, ly] = r.lattice_size(n);
+        mask_words += (r.mask_words() * lx.div_ceil(block[0]) * ly.div_ceil(block[1])) as u64;
+    }
+    RangeTable {
+        rows,
+        full_rows,
+        sample_offsets,
+        mask_words,
     }
 }
 
@@ -143,6 +221,7 @@ struct PushParams {
     sea_level: f32,
     basin_water_offset: f32,
     grid_size: u32,
+    first_job: u32,
 }
 
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
@@ -151,12 +230,14 @@ pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 
 /// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
-/// spacing and samples.
+/// spacing and samples; and for jobs that take their even vertices from their parent (10.2), the parent's slot
+/// (its river texture in the GENERAL layout) and quadrant. `parents` is empty or as long as `jobs`.
 #[derive(Clone, Copy)]
 pub struct KernelBatch<'a> {
     pub textures: &'a [&'a Image],
     pub slots: &'a [Slot],
     pub jobs: &'a [PatchJob<'a>],
+    pub parents: &'a [Option<(Slot, ParentQuadrant)>],
 }
 
 /// Both kernel pipelines, ready to record dispatches.
@@ -239,13 +320,8 @@ impl RiverKernel {
         batch: &KernelBatch,
         params: &KernelParams,
     ) -> Result<u64, GpuError> {
-        let KernelBatch {
-            textures,
-            slots,
-            jobs,
-        } = *batch;
         rec.image_transitions(
-            textures,
+            batch.textures,
             vk::ImageLayout::UNDEFINED,
             vk::ImageLayout::GENERAL,
             vk::PipelineStageFlags2::NONE,
@@ -253,8 +329,17 @@ impl RiverKernel {
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
         );
-        if jobs.is_empty() {
+        if batch.jobs.is_empty() {
             return Ok(0);
+        }
+        if batch.parents.iter().any(Option::is_some) {
+            // The parents' river textures were written by an earlier dispatch.
+            rec.memory_barrier(
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ,
+            );
         }
         let ctx = rec.ctx();
         let host_buffer = |name: &str, size: usize| {
@@ -265,68 +350,81 @@ impl RiverKernel {
                 location: MemoryLocation::CpuToGpu,
             })
         };
-        let table = range_table(jobs, slots);
-        let mut job_buffer = host_buffer("river range table", std::mem::size_of_val(&table[..]))?;
-        job_buffer.write(0, &table)?;
+        let n = self.grid_size;
+        let table = range_table(batch, n, self.tuning.tiled_block);
+        let rows = &table.rows;
+        let mut job_buffer = host_buffer("river range table", std::mem::size_of_val(&rows[..]))?;
+        job_buffer.write(0, rows)?;
         // Every patch's samples are written straight into the mapped buffer at its range.
         let sample_bytes = std::mem::size_of::<RiverSample>();
-        let total: usize = jobs.iter().map(|j| j.samples.len()).sum();
+        let total: usize = batch.jobs.iter().map(|j| j.samples.len()).sum();
         let mut sample_buffer = host_buffer("river samples", total * sample_bytes)?;
-        for (job, row) in jobs.iter().zip(&table) {
-            sample_buffer.write(row.sample_offset as usize * sample_bytes, job.samples)?;
+        for (job, offset) in batch.jobs.iter().zip(&table.sample_offsets) {
+            sample_buffer.write(*offset as usize * sample_bytes, job.samples)?;
         }
         let bytes = sample_buffer.size + job_buffer.size;
-        let push = PushParams {
+        // Rows over whole patches, then rows over every second vertex (from the parent's patches).
+        let half = n.div_ceil(2);
+        let groups = [
+            (0, table.full_rows, [n, n]),
+            (table.full_rows, rows.len() - table.full_rows, [half, half]),
+        ];
+        let push = |first_job: usize| PushParams {
             influence_distance: params.influence_distance,
             basin_depth: params.basin_depth,
             sea_level: params.sea_level,
             basin_water_offset: params.basin_water_offset,
-            grid_size: self.grid_size,
+            grid_size: n,
+            first_job: first_job as u32,
         };
-        let push = bytemuck::bytes_of(&push);
-        let n = self.grid_size;
         let inputs = [&sample_buffer, &job_buffer];
         let dispatched = match variant {
             KernelVariant::Simple => rec.buffer_set(&self.inputs, &inputs).map(|set| {
-                let groups = [
-                    (n * n).div_ceil(self.tuning.simple_workgroup),
-                    table.len() as u32,
-                    1,
-                ];
-                rec.dispatch(&self.simple, &[bindless.set, set], push, groups);
+                for (first, count, [x, y]) in groups.into_iter().filter(|g| g.1 > 0) {
+                    let size = [
+                        (x * y).div_ceil(self.tuning.simple_workgroup),
+                        count as u32,
+                        1,
+                    ];
+                    let push = push(first);
+                    rec.dispatch(
+                        &self.simple,
+                        &[bindless.set, set],
+                        bytemuck::bytes_of(&push),
+                        size,
+                    );
+                }
                 0
             }),
-            KernelVariant::Tiled => self.record_tiled(rec, bindless, inputs, &table, push),
+            KernelVariant::Tiled => self.record_tiled(rec, bindless, inputs, &table, groups, push),
         };
         rec.free_after_completion(sample_buffer);
         rec.free_after_completion(job_buffer);
         Ok(bytes + dispatched?)
     }
 
-    /// The tiled variant: clears the reach masks, runs the pre-pass that fills them, then the tiled kernel.
-    /// Returns the size of the mask buffer, which is freed when the submission completes.
+    /// The tiled variant: clears the reach masks, runs the pre-pass that fills them, then the tiled kernel over
+    /// each group of rows (first row, rows, lattice size). Returns the size of the mask buffer, which is freed
+    /// when the submission completes.
     fn record_tiled(
         &self,
         rec: &mut Recorder,
         bindless: &Bindless,
         [samples, table_buffer]: [&Buffer; 2],
-        table: &[GpuPatchJob],
-        push: &[u8],
+        table: &RangeTable,
+        groups: [(usize, usize, [u32; 2]); 2],
+        push: impl Fn(usize) -> PushParams,
     ) -> Result<u64, GpuError> {
-        let n = self.grid_size;
         let [bx, by] = self.tuning.tiled_block;
-        let blocks = [n.div_ceil(bx), n.div_ceil(by)];
-        let words: u64 = table.iter().map(|j| j.mask_words() as u64).sum();
         let masks = rec.ctx().create_buffer(&BufferDesc {
             name: "river reach masks",
-            size: (words * (blocks[0] * blocks[1]) as u64 * 4).max(16),
+            size: (table.mask_words * 4).max(16),
             usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             location: MemoryLocation::GpuOnly,
         })?;
         let size = masks.size;
         let set = rec.buffer_set(&self.tiled_inputs, &[samples, table_buffer, &masks]);
         if let Ok(set) = set {
-            let patches = table.len() as u32;
             rec.fill_buffer(&masks, 0);
             rec.buffer_barrier(
                 &masks,
@@ -335,7 +433,13 @@ impl RiverKernel {
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
             );
-            rec.dispatch(&self.reach, &[bindless.set, set], push, [1, patches, 1]);
+            let rows = table.rows.len() as u32;
+            rec.dispatch(
+                &self.reach,
+                &[bindless.set, set],
+                bytemuck::bytes_of(&push(0)),
+                [1, rows, 1],
+            );
             rec.buffer_barrier(
                 &masks,
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
@@ -343,8 +447,16 @@ impl RiverKernel {
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_READ,
             );
-            let groups = [blocks[0], blocks[1], patches];
-            rec.dispatch(&self.tiled, &[bindless.set, set], push, groups);
+            for (first, count, [x, y]) in groups.into_iter().filter(|g| g.1 > 0) {
+                let size = [x.div_ceil(bx), y.div_ceil(by), count as u32];
+                let push = push(first);
+                rec.dispatch(
+                    &self.tiled,
+                    &[bindless.set, set],
+                    bytemuck::bytes_of(&push),
+                    size,
+                );
+            }
         }
         rec.free_after_completion(masks);
         set.map(|_| size)
@@ -375,27 +487,6 @@ pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result
         aspect: vk::ImageAspectFlags::COLOR,
         array: true,
     })
-}
-
-/// The range table of a batch: patch k's samples follow those of the patches before it in one sample buffer,
-/// and its results go to `slots[k]`.
-pub fn range_table(jobs: &[PatchJob], slots: &[Slot]) -> Vec<GpuPatchJob> {
-    let (mut sample_offset, mut mask_offset) = (0, 0);
-    jobs.iter()
-        .zip(slots)
-        .map(|(job, slot)| {
-            let row = GpuPatchJob {
-                spacing: job.spacing,
-                sample_offset,
-                sample_count: job.samples.len() as u32,
-                slot: slot.0,
-                mask_offset,
-            };
-            sample_offset += row.sample_count;
-            mask_offset += row.mask_words();
-            row
-        })
-        .collect()
 }
 
 /// Decodes one read-back river texture (both layers, tightly packed RGBA32F) into texels.
@@ -476,6 +567,11 @@ impl BatchOutputs {
         Ok(outputs)
     }
 
+    /// The bindless slots of the textures, in order.
+    pub fn slots(&self) -> &[Slot] {
+        &self.slots
+    }
+
     /// Bytes of one patch's two layers, tightly packed.
     fn texel_bytes(grid_size: u32) -> u64 {
         (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
@@ -504,18 +600,21 @@ pub fn run_batch(
     params: &KernelParams,
 ) -> Result<BatchResult, GpuError> {
     let outputs = BatchOutputs::new(ctx, bindless, jobs.len(), kernel.grid_size)?;
-    let result = run_batch_into(ctx, bindless, kernel, variant, jobs, params, &outputs);
+    let result = run_batch_into(ctx, bindless, kernel, variant, jobs, &[], params, &outputs);
     outputs.destroy(ctx, bindless);
     result
 }
 
 /// [`run_batch`] into existing outputs (at least one texture per job): upload, dispatch, readback, decode.
+/// `parents` as in [`KernelBatch`].
+#[allow(clippy::too_many_arguments)]
 pub fn run_batch_into(
     ctx: &Context,
     bindless: &Bindless,
     kernel: &RiverKernel,
     variant: KernelVariant,
     jobs: &[PatchJob],
+    parents: &[Option<(Slot, ParentQuadrant)>],
     params: &KernelParams,
     outputs: &BatchOutputs,
 ) -> Result<BatchResult, GpuError> {
@@ -540,6 +639,7 @@ pub fn run_batch_into(
             textures: &image_refs,
             slots,
             jobs,
+            parents,
         };
         let scope = profiler.begin(rec, "kernel")?;
         let bytes = kernel.record(rec, bindless, variant, &batch, params)?;

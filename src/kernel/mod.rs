@@ -75,6 +75,33 @@ pub struct PatchJob<'a> {
     pub samples: &'a [RiverSample],
 }
 
+/// Where a child patch's river data can come from its parent (10.2, the thesis's future work): with an odd number
+/// of vertices per side, the child's even vertices (2i, 2j) are the parent's vertices `offset + (i, j)` of the
+/// quadrant the child covers. When the parent's samples are the rivers' final detail
+/// ([`crate::river::samples::PatchSamples::final_detail`]), the river data there is the same, so only the other
+/// three quarters of the vertices need the kernel (docs/kernel.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParentQuadrant {
+    pub offset: [u32; 2],
+}
+
+impl ParentQuadrant {
+    /// The quadrant of `patch`'s parent that `patch` covers; `None` for a root or an even vertex count.
+    pub fn of(patch: crate::planet::cube::PatchId, n: u32) -> Option<Self> {
+        (patch.level > 0 && n % 2 == 1).then(|| {
+            let half = (n - 1) / 2;
+            Self {
+                offset: [(patch.x % 2) * half, (patch.y % 2) * half],
+            }
+        })
+    }
+
+    /// The parent vertex that child vertex (i, j) coincides with, if both are even.
+    pub fn parent_vertex(self, i: u32, j: u32) -> Option<(u32, u32)> {
+        (i % 2 == 0 && j % 2 == 0).then(|| (self.offset[0] + i / 2, self.offset[1] + j / 2))
+    }
+}
+
 /// Vertex (i, j) of a patch, in the patch frame.
 pub fn vertex_position(i: u32, j: u32, spacing: f32) -> [f32; 2] {
     [i as f32 * spacing, j as f32 * spacing]

@@ -229,6 +229,19 @@ impl PatchId {
         }
     }
 
+    /// The patch of `level` that `direction` points through (on the face [`face_of`] names).
+    pub fn containing(direction: DVec3, level: u8) -> Self {
+        let (face, u, v) = face_of(direction);
+        let count = 1u64 << level;
+        let cell = |t: f64| (((t + 1.0) * 0.5 * count as f64) as u64).min(count - 1) as u32;
+        Self {
+            face: face as u8,
+            level,
+            x: cell(u),
+            y: cell(v),
+        }
+    }
+
     pub fn parent(self) -> Option<Self> {
         (self.level > 0).then(|| Self {
             face: self.face,

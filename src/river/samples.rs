@@ -73,12 +73,24 @@ pub fn influencing<'a>(
     network.systems.iter().filter(move |s| influences(s, frame))
 }
 
+/// A patch's river samples, and whether they are the rivers' final detail.
+#[derive(Clone, Debug, Default)]
+pub struct PatchSamples {
+    pub samples: Vec<RiverSample>,
+    /// Whether every piece these samples come from is as fine as any level subdivides it (at [`MAX_DEPTH`] or
+    /// no longer than [`sample_step`]) and sampled [`sample_step`] apart. Then every descendant patch gets the
+    /// same samples within its reach, so its river data equals the parent's where their vertices coincide: the
+    /// condition for taking them from the parent (10.2).
+    pub final_detail: bool,
+}
+
 /// Section 6.4: the samples of every river influencing the patch, with each river brought to the patch's level
 /// of detail: pieces are subdivided until their control polygon is at most four vertex spacings long. Samples
 /// lie at most `width / (2 x samples-per-half-width)` apart along each piece (measured in the patch frame), and
 /// only samples that can reach the patch are kept.
-pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> Vec<RiverSample> {
+pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> PatchSamples {
     let mut out = Vec::new();
+    let mut final_detail = true;
     for system in influencing(network, frame) {
         let Some(outline) = frame.outline_in(system) else {
             continue;
@@ -104,6 +116,9 @@ pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> Vec<RiverSam
             }
             let target = (4.0 * frame.spacing()).max(sample_step(network, piece.narrowest()));
             if length <= target || piece.depth >= MAX_DEPTH {
+                let step = sample_step(network, piece.narrowest());
+                final_detail &= (length <= step || piece.depth >= MAX_DEPTH)
+                    && sample_floor(network, frame) <= step;
                 emit(network, system, frame, &outline, &piece, reach, &mut out);
             } else {
                 let (children, tributary) = subdivide(&piece, &network.params);
@@ -114,7 +129,10 @@ pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> Vec<RiverSam
             }
         }
     }
-    out
+    PatchSamples {
+        samples: out,
+        final_detail,
+    }
 }
 
 /// The samples of `piece` within reach of the patch outline.
@@ -141,6 +159,15 @@ pub fn sample_step(network: &RiverNetwork, width: f64) -> f64 {
     width / (2.0 * network.samples_per_half_width as f64) * 0.5
 }
 
+/// The least distance between samples on a patch: the vertex spacing / `samples-per-vertex-spacing` (0: none,
+/// as the thesis).
+fn sample_floor(network: &RiverNetwork, frame: &PatchFrame) -> f64 {
+    match network.samples_per_vertex_spacing {
+        0 => 0.0,
+        k => frame.spacing() / k as f64,
+    }
+}
+
 /// Samples of one piece over t in [0, 1) (the next piece starts where this one ends), each with its river-frame
 /// position, [`sample_step`] apart; with `samples-per-vertex-spacing` set, at least that share of the patch's
 /// vertex spacing apart (beyond the thesis).
@@ -150,10 +177,7 @@ pub fn piece_samples<'a>(
     frame: &'a PatchFrame,
     piece: &'a Segment,
 ) -> impl Iterator<Item = (DVec2, RiverSample)> + 'a {
-    let floor = match network.samples_per_vertex_spacing {
-        0 => 0.0,
-        k => frame.spacing() / k as f64,
-    };
+    let floor = sample_floor(network, frame);
     let transform = move |p: DVec2| frame.to_patch(system.frame.to_sphere(p));
     let h = 1e-3 * network.influence_distance;
     let mut t = 0.0;

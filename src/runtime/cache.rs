@@ -19,6 +19,8 @@ pub struct PatchData {
     pub base_slot: Slot,
     pub river: Option<(Image, Slot)>,
     pub samples: usize,
+    /// Whether the samples were the rivers' final detail: then children take river data from this patch (10.2).
+    pub river_final: bool,
     /// Lowest and highest base height (with the border): whether the patch can show sea, and the bounds of its
     /// vertices for the level of detail. Exact once known (uploaded, or read back after refinement).
     pub height_range: (f32, f32),
@@ -32,7 +34,7 @@ impl PatchData {
     pub fn new(
         (base, base_slot): (Image, Slot),
         river: Option<(Image, Slot)>,
-        samples: usize,
+        (samples, river_final): (usize, bool),
         height_range: (f32, f32),
         river_range: Option<(f32, f32)>,
     ) -> Self {
@@ -41,6 +43,7 @@ impl PatchData {
             base_slot,
             river,
             samples,
+            river_final,
             height_range,
             river_range,
             last_used: 0,

@@ -149,6 +149,10 @@ pub struct Renderer<'w> {
     /// Beyond the thesis: patches selected by their nearest point and morphed towards their parent before a
     /// switch (CDLOD); `false`: the thesis's Eq. 6.1 on patch centres and instant switching.
     pub morphing: bool,
+    /// Beyond the thesis (its future work, 10.2): a patch whose parent has the rivers' final detail copies the
+    /// parent's river data at their shared vertices and computes only the rest; `false`: every patch from
+    /// scratch, as the thesis.
+    pub parent_reuse: bool,
     /// Unit direction towards the sun; `None`: over the camera's shoulder.
     pub sun: Option<DVec3>,
     /// Keep each frame's kernel input in `last_batch` (for benchmarks that rerun it through every variant).
@@ -264,6 +268,7 @@ impl<'w> Renderer<'w> {
             wireframe_on: false,
             freeze_lod: false,
             morphing: true,
+            parent_reuse: true,
             sun: None,
             capture_batches: false,
             last_batch: Vec::new(),

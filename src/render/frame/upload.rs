@@ -11,7 +11,7 @@ use crate::{
     gpu::{bindless::Slot, vk, GpuError, Image, Recorder},
     kernel::{
         gpu::{create_river_texture, KernelBatch},
-        PatchJob, RiverSample,
+        ParentQuadrant, PatchJob, RiverSample,
     },
     planet::{cube::PatchId, detail::PatchHeights},
     refine::{create_height_texture, prepare_height_textures, RefineJob, RefinedRanges},
@@ -25,6 +25,8 @@ pub(super) struct NewPatch {
     patch: PatchId,
     heights: Option<PatchHeights>,
     pub samples: Vec<RiverSample>,
+    /// Whether the samples are the rivers' final detail (children may take river data from this patch).
+    final_detail: bool,
 }
 
 /// What recording the new patches left for after the frame.
@@ -45,11 +47,15 @@ impl Renderer<'_> {
         let n = self.config.rendering.vertices;
         let precomputed = planet.precomputed_level;
         plan.par_iter()
-            .map(|&p| NewPatch {
-                patch: p,
-                heights: (p.level as u32 <= precomputed)
-                    .then(|| planet.lattice.patch_heights(p, n)),
-                samples: patch_samples(network, &PatchFrame::new(p, planet.radius, n)),
+            .map(|&p| {
+                let samples = patch_samples(network, &PatchFrame::new(p, planet.radius, n));
+                NewPatch {
+                    patch: p,
+                    heights: (p.level as u32 <= precomputed)
+                        .then(|| planet.lattice.patch_heights(p, n)),
+                    samples: samples.samples,
+                    final_detail: samples.final_detail,
+                }
             })
             .collect()
     }
@@ -159,6 +165,7 @@ impl Renderer<'_> {
 
         let mut rivers: Vec<(Image, Slot)> = Vec::new();
         let mut patch_jobs: Vec<PatchJob> = Vec::new();
+        let mut parents: Vec<Option<(Slot, ParentQuadrant)>> = Vec::new();
         let mut river_of: Vec<Option<usize>> = Vec::with_capacity(prepared.len());
         for p in prepared {
             if p.samples.is_empty() {
@@ -173,6 +180,7 @@ impl Renderer<'_> {
                 spacing: PatchFrame::new(p.patch, self.planet.radius, n).spacing() as f32,
                 samples: &p.samples,
             });
+            parents.push(self.river_parent(p.patch));
             river_of.push(Some(rivers.len()));
             rivers.push((image, slot));
         }
@@ -183,6 +191,7 @@ impl Renderer<'_> {
                 textures: &textures,
                 slots: &slots,
                 jobs: &patch_jobs,
+                parents: &parents,
             };
             let scope = self.profiler.begin(rec, "kernel")?;
             bytes += self
@@ -207,7 +216,7 @@ impl Renderer<'_> {
                 PatchData::new(
                     (base, slot),
                     river,
-                    p.samples.len(),
+                    (p.samples.len(), p.final_detail),
                     made[&p.patch].1,
                     river_range(&p.samples, self.config.river.basin_depth),
                 ),
@@ -218,6 +227,21 @@ impl Renderer<'_> {
             river_patches: river_count,
             ranges,
         })
+    }
+}
+
+impl Renderer<'_> {
+    /// Where `patch` takes river data from (10.2): its parent's river texture and quadrant, when parent reuse is
+    /// on and the resident parent has the rivers' final detail (it was made in an earlier frame: the cache
+    /// holds only those).
+    fn river_parent(&mut self, patch: PatchId) -> Option<(Slot, ParentQuadrant)> {
+        if !self.parent_reuse {
+            return None;
+        }
+        let quadrant = ParentQuadrant::of(patch, self.config.rendering.vertices)?;
+        let data = self.cache.touch(&patch.parent()?)?;
+        let (_, slot) = data.river.as_ref().filter(|_| data.river_final)?;
+        Some((*slot, quadrant))
     }
 }
 
