@@ -3,7 +3,7 @@
 // every invocation reads the tile from there; a barrier guards the next tile's load.
 //
 // Beyond the thesis (docs/kernel.md):
-// - a workgroup is a block of the patch's vertices (x, y from the workgroup id; z selects the patch), its
+// - a workgroup is a block of a row's vertices (x, y from the workgroup id; z selects the row), its
 //   invocations laid out in Morton order, so that every subgroup covers a compact square of vertices;
 // - staging copies only the samples that the reach masks of kernel_reach.comp mark for this block, compacted in
 //   their original order (a subgroup scan of the mask words' bit counts gives each word its place);

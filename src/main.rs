@@ -83,6 +83,9 @@ enum Command {
         flight_stress: PathBuf,
         #[arg(long)]
         long_flight: Option<PathBuf>,
+        /// The report of `bench kernel --parent-reuse`.
+        #[arg(long)]
+        kernel_reuse: Option<PathBuf>,
         /// Reports of `bench flight --descent` (repeat the option for several).
         #[arg(long)]
         descent: Vec<PathBuf>,
@@ -305,6 +308,7 @@ fn main() -> ExitCode {
             flight,
             flight_stress,
             long_flight,
+            kernel_reuse,
             descent,
             commands,
             out,
@@ -316,6 +320,7 @@ fn main() -> ExitCode {
                 flight: &flight,
                 flight_stress: &flight_stress,
                 long_flight: long_flight.as_deref(),
+                kernel_reuse: kernel_reuse.as_deref(),
                 descents: &descent,
                 commands: &commands,
             };

@@ -4,19 +4,24 @@
 
 mod common;
 
-use std::path::Path;
+use std::{collections::HashMap, path::Path};
 
 use riverplanet::{
     config::Config,
-    gpu::bindless::Bindless,
+    gpu::{bindless::Bindless, vk},
     kernel::{
         cpu,
         gpu::{run_batch_into, BatchOutputs, KernelTuning, KernelVariant, RiverKernel},
         max_abs_diff, KernelParams, ParentQuadrant, PatchJob, RiverTexel,
     },
     planet::cube::PatchId,
-    render::presets::{self, Preset},
+    render::{
+        presets::{self, Preset},
+        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        Renderer, VertexCapture,
+    },
     river::samples::{patch_samples, PatchFrame, PatchSamples},
+    runtime::camera::Camera,
     world::World,
 };
 
@@ -174,4 +179,82 @@ fn above_the_final_detail_the_parent_draws_other_rivers_than_its_children() {
         "level {}: {diff} <= {tolerance}",
         column[first - 3].0.level
     );
+}
+
+/// The ground preset of config/earth.xml rendered until everything has streamed in: the drawn vertices (relative
+/// to the camera, by patch) and how many patches took river data from their parent on the way.
+fn ground_vertices(parent_reuse: bool) -> Option<(VertexCapture, usize)> {
+    let ctx = common::gpu()?;
+    let mut config =
+        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml")).unwrap();
+    config.rendering.generation_budget_ms = 1e6;
+    let world = World::build(&config, config.resolve_seed()).unwrap();
+    let (eye, look_at) = presets::camera(Preset::Ground, &world).unwrap();
+    let camera = Camera::look_at(eye, look_at, 60.0, 16.0 / 9.0, 0.1);
+    let offscreen = Offscreen::new(ctx, 64, 36).unwrap();
+    let target = offscreen.target([0.0, 0.0, 0.0, 1.0]);
+    let mut renderer = Renderer::new(
+        ctx,
+        &world.planet,
+        &world.network,
+        &world.config,
+        COLOR_FORMAT,
+        DEPTH_FORMAT,
+    )
+    .unwrap();
+    renderer.parent_reuse = parent_reuse;
+    let mut layout = vk::ImageLayout::UNDEFINED;
+    let mut from_parent = 0;
+    for _ in 0..60 {
+        let (stats, _) = renderer
+            .render_until_streamed(&camera, &target, &mut layout, 1)
+            .unwrap();
+        from_parent += stats.river_patches_from_parent;
+        if stats.streamed() {
+            break;
+        }
+    }
+    renderer.capture_vertices = true;
+    renderer
+        .render_until_streamed(&camera, &target, &mut layout, 1)
+        .unwrap();
+    let capture = renderer.last_capture.take().unwrap();
+    renderer.destroy();
+    offscreen.destroy(ctx);
+    common::assert_no_validation_errors(ctx);
+    Some((capture, from_parent))
+}
+
+#[test]
+fn the_ground_view_draws_the_same_terrain_with_and_without_river_data_from_the_parent() {
+    let Some((reused, from_parent)) = ground_vertices(true) else {
+        return;
+    };
+    let (scratch, none) = ground_vertices(false).unwrap();
+    assert!(from_parent > 0, "no patch took river data from its parent");
+    assert_eq!(none, 0);
+    let scratch: HashMap<PatchId, &Vec<[f32; 4]>> =
+        scratch.patches.iter().map(|(p, v)| (*p, v)).collect();
+    let (mut compared, mut worst) = (0, 0.0f32);
+    for (patch, vertices) in &reused.patches {
+        let Some(other) = scratch.get(patch) else {
+            continue;
+        };
+        // Vertices of quadrants drawn in both views.
+        for (a, b) in vertices
+            .iter()
+            .zip(other.iter())
+            .filter(|(a, b)| a[3] > 0.0 && b[3] > 0.0)
+        {
+            compared += 1;
+            for k in 0..3 {
+                worst = worst.max((a[k] - b[k]).abs());
+            }
+        }
+    }
+    println!("{compared} vertices compared, largest difference {worst} m");
+    assert!(compared > 10_000, "only {compared} vertices in both views");
+    // A millimetre: the children's frames round positions differently from the parent's (the kernel test's
+    // tolerance of a few f32 steps of heights of thousands of metres).
+    assert!(worst <= 1e-3, "the views differ by {worst} m");
 }

@@ -29,6 +29,8 @@ pub struct ReportInputs<'a> {
     pub flight: &'a Path,
     pub flight_stress: &'a Path,
     pub long_flight: Option<&'a Path>,
+    /// The report of `bench kernel --parent-reuse`.
+    pub kernel_reuse: Option<&'a Path>,
     /// Reports of `bench flight --descent` (any number: planets, thesis mode).
     pub descents: &'a [std::path::PathBuf],
     /// The command lines that made the inputs, for the record.
@@ -174,6 +176,9 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         f(&k["relative_diff"]),
         f(&ks["relative_diff"]),
     );
+    if let Some(path) = inputs.kernel_reuse {
+        reuse_section(w, &read(path)?);
+    }
     for (title, r, prefix) in [
         ("The approach", &fl, ""),
         ("The stress test", &fs, "stress_"),
@@ -281,8 +286,8 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             "## The descent to the ground\n\nBeyond the thesis: `bench flight --descent` from three radii out to 2 world \
              units above the first river's water (60 % of the frames), then turning a quarter round there; every tenth \
              frame is checked for holes (docs/rendering.md). Frame times include waiting for the GPU.\n\n\
-             | report | planet radius | morphing | frames | deepest level | peak memory | frame ms median | max after 10 frames | max / median | hole pixels (frames checked) |\n\
-             |---|---|---|---|---|---|---|---|---|---|"
+             | report | planet radius | morphing | river data from the parent | frames | deepest level | peak memory | frame ms median | max after 10 frames | max / median | hole pixels (frames checked) |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|"
         );
         for path in inputs.descents {
             let d = read(path)?;
@@ -290,10 +295,11 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             let _ =
                 writeln!(
                 w,
-                "| {} | {} | {} | {} at {}x{} | {} | {:.1} MB | {:.1} | {:.1} | {:.2} | {} ({}) |",
+                "| {} | {} | {} | {} | {} at {}x{} | {} | {:.1} MB | {:.1} | {:.1} | {:.2} | {} ({}) |",
                 path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 d["radius"],
                 if d["morphing"].as_bool().unwrap_or(true) { "yes" } else { "no (thesis)" },
+                if d["parent_reuse"].as_bool().unwrap_or(true) { "yes" } else { "no (thesis)" },
                 s["frames"],
                 d["resolution"][0],
                 d["resolution"][1],
@@ -314,6 +320,47 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         inputs.commands.trim()
     );
     Ok(md)
+}
+
+/// The comparison of `bench kernel --parent-reuse`: river data from the parent against from scratch.
+fn reuse_section(w: &mut String, r: &Value) {
+    let (a, b) = (&r["from_scratch"], &r["from_parent"]);
+    let _ = writeln!(
+        w,
+        "## River data from the parent patch (10.2)\n\n\
+         Beyond the thesis (its future work): a patch whose parent has the rivers' final detail copies the parent's \
+         river data at their shared vertices and computes only the other three quarters (docs/kernel.md). Workload: \
+         {}: {} patches from {} parents, {} samples. Kernel time, median of {} runs, on identical input:\n\n\
+         | variant | from scratch (thesis) | from the parent | speedup |\n|---|---|---|---|"
+    ,
+        r["workload"].as_str().unwrap_or(""),
+        r["patches"],
+        r["parents"],
+        r["samples"],
+        r["repetitions"],
+    );
+    for (k, (name, key)) in [
+        ("CPU single thread", "cpu_single_ms"),
+        ("GPU simple kernel", "gpu_simple_ms"),
+        ("GPU tiled kernel", "gpu_tiled_ms"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let _ = writeln!(
+            w,
+            "| {name} | {:.1} ms | {:.1} ms | {:.2}x |",
+            f(&a[key]),
+            f(&b[key]),
+            f(&r["speedup"][k])
+        );
+    }
+    let _ = writeln!(
+        w,
+        "\nVertices computed: {} from scratch, {} from the parent. Largest difference between the two: {:.2e} \
+         (f32 rounding of positions in the children's frames).\n",
+        a["computed_vertices"], b["computed_vertices"], f(&r["max_abs_diff"]),
+    );
 }
 
 fn map_ms(v: &Value) -> String {

@@ -1,6 +1,7 @@
 //! The GPU river kernel (Chapter 7): the simple (7.3.1) and tiled (7.3.2) compute shaders, and the recording of
-//! one dispatch that computes every new patch of a frame. A range table (one [`GpuPatchJob`] per patch) maps the
-//! workgroups' y index to the patch's sample range and output slot.
+//! the dispatch that computes every new patch of a frame. A range table (one [`GpuPatchJob`] per patch, four for a
+//! patch that takes river data from its parent) maps the workgroups' row index to the sample range, the output
+//! slot and the vertices of the row.
 
 use bytemuck::{Pod, Zeroable};
 

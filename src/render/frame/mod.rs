@@ -79,6 +79,8 @@ pub struct FrameStats {
     pub new_patches: usize,
     /// New patches influenced by rivers (computed by the kernel this frame).
     pub river_patches: usize,
+    /// Of those, patches that took their even vertices from their parent (10.2).
+    pub river_patches_from_parent: usize,
     /// Visible patches drawn with an ancestor's data because theirs has not arrived yet.
     pub fallback_patches: usize,
     /// Patches still waiting for data after this frame.
@@ -340,6 +342,7 @@ impl<'w> Renderer<'w> {
         let uploaded = self.upload_new_patches(&mut rec, &prepared)?;
         stats.temporary_sample_bytes = uploaded.bytes;
         stats.river_patches = uploaded.river_patches;
+        stats.river_patches_from_parent = uploaded.river_patches_from_parent;
         let drawn = self.record_draw(
             &mut rec,
             camera,

@@ -34,6 +34,8 @@ pub(super) struct Uploaded {
     /// Temporary bytes: samples, range and job tables.
     pub bytes: u64,
     pub river_patches: usize,
+    /// River patches that took their even vertices from their parent.
+    pub river_patches_from_parent: usize,
     /// Where the refined patches' height ranges arrive.
     pub ranges: Option<RefinedRanges>,
 }
@@ -74,6 +76,7 @@ impl Renderer<'_> {
             return Ok(Uploaded {
                 bytes: 0,
                 river_patches: 0,
+                river_patches_from_parent: 0,
                 ranges: None,
             });
         }
@@ -225,6 +228,7 @@ impl Renderer<'_> {
         Ok(Uploaded {
             bytes,
             river_patches: river_count,
+            river_patches_from_parent: parents.iter().flatten().count(),
             ranges,
         })
     }
