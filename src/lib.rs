@@ -12,6 +12,7 @@
 
 pub mod bench;
 pub mod config;
+pub mod drainage;
 pub mod export;
 pub mod gpu;
 pub mod kernel;

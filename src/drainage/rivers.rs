@@ -1,0 +1,313 @@
+//! Rivers and lakes from a routing: lakes where depressions are deep enough, river nodes where drainage area
+//! passes a threshold, and the river nodes cut into reaches between heads, confluences and mouths, each with its
+//! Strahler order and the reach it flows into.
+
+use serde::Serialize;
+
+use super::{
+    grid::SphereGrid,
+    routing::{Routing, NONE},
+};
+
+/// A stretch of river between a head or confluence and the next confluence or mouth.
+#[derive(Clone, Debug)]
+pub struct Reach {
+    /// Nodes in flow order. The first is a head or a confluence; the last is the confluence it joins, or its mouth
+    /// (a sea or lake node).
+    pub nodes: Vec<u32>,
+    /// Strahler order: 1 for a reach from a head, the larger of the joining orders below a confluence, plus one
+    /// when two of the largest meet.
+    pub strahler: u32,
+    /// The reach this one flows into; `None` at a mouth.
+    pub downstream: Option<usize>,
+}
+
+/// A depression deep enough to hold water.
+#[derive(Clone, Debug)]
+pub struct Lake {
+    pub nodes: Vec<u32>,
+    /// The water level: the depression's spill height.
+    pub level: f64,
+}
+
+/// The statistics the issue asks `generate` to report (docs/rivers.md).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct DrainageMeasures {
+    /// River systems: reaches that end at a mouth.
+    pub rivers: usize,
+    pub reaches: usize,
+    pub confluences: usize,
+    pub lakes: usize,
+    pub strahler_max: u32,
+    /// Horton's bifurcation ratio: exp(-slope) of the least-squares line through ln(streams of order w) over w.
+    pub bifurcation_ratio: f64,
+    /// Hack's exponent: least-squares slope of ln(main-stream length) over ln(drainage area) at the lower end of
+    /// every reach.
+    pub hack_exponent: f64,
+    /// Share of the land area that drains through a river or a lake.
+    pub drained_land_fraction: f64,
+    /// Steps along a reach where the bed rises downstream.
+    pub uphill_steps: usize,
+    /// Lattice quads whose two diagonals both carry a river (two rivers crossing).
+    pub crossings: usize,
+}
+
+/// What the routing makes of a planet's heights.
+pub struct DrainageNetwork {
+    pub reaches: Vec<Reach>,
+    pub lakes: Vec<Lake>,
+    /// Per node: the lake it belongs to.
+    pub lake_of: Vec<Option<u32>>,
+    pub measures: DrainageMeasures,
+}
+
+/// Thresholds of extraction, in units of the unit sphere.
+#[derive(Clone, Copy, Debug)]
+pub struct Thresholds {
+    /// Drainage area at which a river starts.
+    pub river_area: f64,
+    /// Depth a depression needs to be kept as a lake.
+    pub lake_depth: f64,
+}
+
+/// Extracts rivers and lakes from `routing` over `heights` (the unfilled heights; nodes at or below `sea_level`
+/// are sea).
+pub fn extract(
+    grid: &SphereGrid,
+    routing: &Routing,
+    heights: &[f64],
+    sea_level: f64,
+    thresholds: Thresholds,
+) -> DrainageNetwork {
+    let n = grid.len();
+    let sea = |k: usize| heights[k] <= sea_level;
+    let (lakes, lake_of) = lakes(grid, routing, heights, sea_level, thresholds.lake_depth);
+    let river: Vec<bool> = (0..n)
+        .map(|k| !sea(k) && lake_of[k].is_none() && routing.area[k] >= thresholds.river_area)
+        .collect();
+    let mut donors = vec![0u32; n];
+    for k in 0..n {
+        let r = routing.receiver[k];
+        if river[k] && r != NONE {
+            donors[r as usize] += 1;
+        }
+    }
+    // Reaches start at heads and confluences, upstream first, so a reach comes after every reach that joins it.
+    let mut reaches: Vec<Reach> = Vec::new();
+    let mut starting_at = vec![u32::MAX; n];
+    for &k in &routing.upstream_first {
+        let k = k as usize;
+        if !river[k] || donors[k] == 1 {
+            continue;
+        }
+        let mut nodes = vec![k as u32];
+        let mut at = k;
+        loop {
+            let r = routing.receiver[at];
+            if r == NONE {
+                break;
+            }
+            nodes.push(r);
+            at = r as usize;
+            if !river[at] || donors[at] >= 2 {
+                break;
+            }
+        }
+        starting_at[k] = reaches.len() as u32;
+        reaches.push(Reach {
+            nodes,
+            strahler: 1,
+            downstream: None,
+        });
+    }
+    // Links and Strahler orders, upstream first.
+    let mut incoming: Vec<Vec<u32>> = vec![Vec::new(); reaches.len()];
+    for r in 0..reaches.len() {
+        let end = *reaches[r].nodes.last().unwrap() as usize;
+        let below = starting_at[end];
+        if below != u32::MAX && river[end] {
+            reaches[r].downstream = Some(below as usize);
+            incoming[below as usize].push(r as u32);
+        }
+    }
+    for r in 0..reaches.len() {
+        let orders: Vec<u32> = incoming[r]
+            .iter()
+            .map(|&u| reaches[u as usize].strahler)
+            .collect();
+        if let Some(&top) = orders.iter().max() {
+            let ties = orders.iter().filter(|&&o| o == top).count();
+            reaches[r].strahler = if ties >= 2 { top + 1 } else { top };
+        }
+    }
+    let measures = measure(
+        grid, routing, heights, sea_level, &reaches, &incoming, &river, &lake_of,
+    );
+    DrainageNetwork {
+        measures: DrainageMeasures {
+            lakes: lakes.len(),
+            confluences: donors
+                .iter()
+                .zip(&river)
+                .filter(|(&d, &r)| r && d >= 2)
+                .count(),
+            ..measures
+        },
+        reaches,
+        lakes,
+        lake_of,
+    }
+}
+
+/// Depressions the filling raised by more than `depth` somewhere: connected land nodes raised at all, kept when
+/// the deepest is at least `depth`.
+fn lakes(
+    grid: &SphereGrid,
+    routing: &Routing,
+    heights: &[f64],
+    sea_level: f64,
+    depth: f64,
+) -> (Vec<Lake>, Vec<Option<u32>>) {
+    let n = grid.len();
+    // Raised by more than the epsilon slope could have done: filled water.
+    let raised = |k: usize| heights[k] > sea_level && routing.filled[k] - heights[k] > depth * 1e-3;
+    let mut lake_of = vec![None; n];
+    let mut seen = vec![false; n];
+    let mut lakes = Vec::new();
+    for start in 0..n {
+        if seen[start] || !raised(start) {
+            continue;
+        }
+        let mut nodes = vec![start as u32];
+        seen[start] = true;
+        let mut k = 0;
+        while k < nodes.len() {
+            for &next in grid.neighbours(nodes[k]) {
+                if !seen[next as usize] && raised(next as usize) {
+                    seen[next as usize] = true;
+                    nodes.push(next);
+                }
+            }
+            k += 1;
+        }
+        let deepest = nodes
+            .iter()
+            .map(|&k| routing.filled[k as usize] - heights[k as usize])
+            .fold(0.0, f64::max);
+        if deepest >= depth {
+            let level = nodes
+                .iter()
+                .map(|&k| routing.filled[k as usize])
+                .fold(f64::MIN, f64::max);
+            for &k in &nodes {
+                lake_of[k as usize] = Some(lakes.len() as u32);
+            }
+            lakes.push(Lake { nodes, level });
+        }
+    }
+    (lakes, lake_of)
+}
+
+/// Least-squares slope of y over x.
+fn slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    if points.len() < 2 || sxx == 0.0 {
+        f64::NAN
+    } else {
+        sxy / sxx
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn measure(
+    grid: &SphereGrid,
+    routing: &Routing,
+    heights: &[f64],
+    sea_level: f64,
+    reaches: &[Reach],
+    incoming: &[Vec<u32>],
+    river: &[bool],
+    lake_of: &[Option<u32>],
+) -> DrainageMeasures {
+    let n = grid.len();
+    // Horton: a stream of order w starts where a reach of order w has no incoming reach of order w.
+    let strahler_max = reaches.iter().map(|r| r.strahler).max().unwrap_or(0);
+    let mut streams = vec![0usize; strahler_max as usize + 1];
+    for (r, reach) in reaches.iter().enumerate() {
+        if !incoming[r]
+            .iter()
+            .any(|&u| reaches[u as usize].strahler == reach.strahler)
+        {
+            streams[reach.strahler as usize] += 1;
+        }
+    }
+    let horton: Vec<(f64, f64)> = (1..=strahler_max)
+        .filter(|&w| streams[w as usize] > 0)
+        .map(|w| (w as f64, (streams[w as usize] as f64).ln()))
+        .collect();
+    // Hack: the longest flow path above each node (to the divide), upstream first.
+    let mut longest = vec![0.0f64; n];
+    for &k in &routing.upstream_first {
+        let r = routing.receiver[k as usize];
+        if r != NONE {
+            let length = longest[k as usize] + grid.angle(k, r);
+            longest[r as usize] = longest[r as usize].max(length);
+        }
+    }
+    let hack: Vec<(f64, f64)> = reaches
+        .iter()
+        .filter_map(|reach| {
+            // The last river node of the reach (its mouth node may be sea).
+            let last = reach.nodes.iter().rev().find(|&&k| river[k as usize])?;
+            let (l, a) = (longest[*last as usize], routing.area[*last as usize]);
+            (l > 0.0).then(|| (a.ln(), l.ln()))
+        })
+        .collect();
+    // Drained land: land whose water reaches a river or a lake, downstream first.
+    let mut drained = vec![false; n];
+    let (mut land, mut drained_land) = (0.0, 0.0);
+    for &k in routing.upstream_first.iter().rev() {
+        let k = k as usize;
+        if heights[k] <= sea_level {
+            continue;
+        }
+        let r = routing.receiver[k];
+        drained[k] = river[k] || lake_of[k].is_some() || (r != NONE && drained[r as usize]);
+        land += grid.areas[k];
+        if drained[k] {
+            drained_land += grid.areas[k];
+        }
+    }
+    let uphill_steps = reaches
+        .iter()
+        .flat_map(|r| r.nodes.windows(2))
+        .filter(|w| routing.filled[w[1] as usize] > routing.filled[w[0] as usize])
+        .count();
+    let river_edge = |a: u32, b: u32| {
+        let flows = |x: u32, y: u32| river[x as usize] && routing.receiver[x as usize] == y;
+        flows(a, b) || flows(b, a)
+    };
+    let crossings = grid
+        .quads()
+        .filter(|&[a, b, c, d]| river_edge(a, d) && river_edge(b, c))
+        .count();
+    DrainageMeasures {
+        rivers: reaches.iter().filter(|r| r.downstream.is_none()).count(),
+        reaches: reaches.len(),
+        confluences: 0,
+        lakes: 0,
+        strahler_max,
+        bifurcation_ratio: (-slope(&horton)).exp(),
+        hack_exponent: slope(&hack),
+        drained_land_fraction: if land > 0.0 { drained_land / land } else { 0.0 },
+        uphill_steps,
+        crossings,
+    }
+}

@@ -1,0 +1,141 @@
+//! Drainage networks: flow routing over the whole sphere (Priority-Flood + epsilon, D8), lakes, rivers as trees
+//! with Strahler orders, and the network measures, on synthetic relief whose answer is known and on planets.
+
+use glam::DVec3;
+use riverplanet::{
+    drainage::{
+        grid::SphereGrid,
+        rivers::{extract, Thresholds},
+        routing::{route, NONE},
+    },
+    planet::{cube::FACES, heights::FaceLattice},
+};
+
+/// A lattice of `cells` cells per face edge with heights from a function of the direction.
+fn lattice(cells: u32, height: impl Fn(DVec3) -> f64) -> FaceLattice {
+    let mut l = FaceLattice::new(cells, 0.0);
+    for face in 0..FACES {
+        for j in 0..=cells {
+            for i in 0..=cells {
+                let d = l.direction(l.key(face, i, j));
+                let k = l.index(face, i, j);
+                l.data[k] = height(d) as f32;
+            }
+        }
+    }
+    l
+}
+
+/// Land rising towards the north pole with a ripple, sea below latitude -12 degrees; a pit near the pole.
+fn dome(d: DVec3) -> f64 {
+    if d.z < -0.2 {
+        return -10.0;
+    }
+    let ripple = (d.x * 23.0).sin() * (d.y * 19.0).cos();
+    let pit = 30.0 * (-(d - DVec3::new(0.3, 0.0, 0.95).normalize()).length_squared() / 0.004).exp();
+    40.0 * (d.z + 0.2) + 3.0 * ripple - pit
+}
+
+#[test]
+fn every_land_node_drains_downhill_to_the_sea_across_face_borders() {
+    let l = lattice(48, dome);
+    let grid = SphereGrid::new(&l);
+    assert_eq!(
+        grid.len(),
+        6 * 48 * 48 + 2,
+        "every shared border point once"
+    );
+    let total: f64 = grid.areas.iter().sum();
+    // The trapezoid rule of area_weight integrates the sphere to about 3e-4.
+    assert!(
+        (total / (4.0 * std::f64::consts::PI) - 1.0).abs() < 1e-3,
+        "areas cover the sphere: {total}"
+    );
+    let heights = grid.values(&l);
+    let routing = route(&grid, &heights, 0.0);
+    let mut across_faces = 0;
+    for start in 0..grid.len() as u32 {
+        let mut at = start;
+        for _ in 0..grid.len() {
+            let r = routing.receiver[at as usize];
+            if r == NONE {
+                break;
+            }
+            assert!(grid.neighbours(at).contains(&r));
+            assert!(routing.filled[r as usize] < routing.filled[at as usize]);
+            at = r;
+        }
+        assert!(
+            heights[at as usize] <= 0.0,
+            "node {start} ends on land at {at}"
+        );
+        let r = routing.receiver[start as usize];
+        if r != NONE {
+            let face = |k: u32| riverplanet::planet::cube::face_of(grid.directions[k as usize]).0;
+            across_faces += (face(start) != face(r)) as usize;
+        }
+    }
+    assert!(
+        across_faces > 10,
+        "only {across_faces} flows cross a face border"
+    );
+    // All area ends in the sea: the outlets' drainage areas add up to the sphere.
+    let outlets: f64 = (0..grid.len())
+        .filter(|&k| routing.receiver[k] == NONE)
+        .map(|k| {
+            if heights[k] <= 0.0 {
+                grid.areas[k]
+            } else {
+                0.0
+            }
+        })
+        .sum();
+    let into_sea: f64 = (0..grid.len())
+        .filter(|&k| heights[k] > 0.0 && heights[routing.receiver[k] as usize] <= 0.0)
+        .map(|k| routing.area[k])
+        .sum();
+    assert!((outlets + into_sea - total).abs() < 1e-9 * total);
+}
+
+#[test]
+fn a_pit_becomes_a_lake_at_its_spill_height_and_rivers_form_trees() {
+    let l = lattice(48, dome);
+    let grid = SphereGrid::new(&l);
+    let heights = grid.values(&l);
+    let routing = route(&grid, &heights, 0.0);
+    let network = extract(
+        &grid,
+        &routing,
+        &heights,
+        0.0,
+        Thresholds {
+            river_area: 0.01,
+            lake_depth: 10.0,
+        },
+    );
+    let m = &network.measures;
+    println!("{m:?}");
+    assert_eq!(network.lakes.len(), 1, "the pit");
+    let lake = &network.lakes[0];
+    let bottom = lake
+        .nodes
+        .iter()
+        .map(|&k| heights[k as usize])
+        .fold(f64::MAX, f64::min);
+    assert!(
+        lake.level - bottom > 20.0,
+        "level {} over a bottom of {bottom}",
+        lake.level
+    );
+    assert!(m.rivers > 0 && m.confluences > 0 && m.strahler_max >= 2);
+    assert_eq!(m.uphill_steps, 0);
+    assert_eq!(m.crossings, 0);
+    // Every reach is linked: it ends where its downstream reach starts.
+    for reach in &network.reaches {
+        if let Some(d) = reach.downstream {
+            assert_eq!(reach.nodes.last(), network.reaches[d].nodes.first());
+            assert!(network.reaches[d].strahler >= reach.strahler);
+        }
+    }
+    assert!(m.drained_land_fraction > 0.0 && m.drained_land_fraction <= 1.0);
+}
