@@ -86,8 +86,7 @@ pub fn extract(
         .map(|k| !sea(k) && lake_of[k].is_none() && routing.area[k] >= thresholds.river_area)
         .collect();
     let mut donors = vec![0u32; n];
-    for k in 0..n {
-        let r = routing.receiver[k];
+    for (k, &r) in routing.receiver.iter().enumerate() {
         if river[k] && r != NONE {
             donors[r as usize] += 1;
         }
@@ -122,11 +121,11 @@ pub fn extract(
     }
     // Links and Strahler orders, upstream first.
     let mut incoming: Vec<Vec<u32>> = vec![Vec::new(); reaches.len()];
-    for r in 0..reaches.len() {
-        let end = *reaches[r].nodes.last().unwrap() as usize;
+    for (r, reach) in reaches.iter_mut().enumerate() {
+        let end = *reach.nodes.last().unwrap() as usize;
         let below = starting_at[end];
         if below != u32::MAX && river[end] {
-            reaches[r].downstream = Some(below as usize);
+            reach.downstream = Some(below as usize);
             incoming[below as usize].push(r as u32);
         }
     }

@@ -27,12 +27,17 @@ pub struct Routing {
 }
 
 /// An f64 height ordered for the heap (heights are finite).
-#[derive(PartialEq, PartialOrd)]
+#[derive(PartialEq)]
 struct Height(f64);
 impl Eq for Height {}
 impl Ord for Height {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
         self.0.total_cmp(&other.0)
+    }
+}
+impl PartialOrd for Height {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
     }
 }
 
