@@ -66,9 +66,25 @@ pub struct PlanetConfig {
     pub base_resolution: u32,
 }
 
+/// Where rivers come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RiverModel {
+    /// Chapter 5: one river per mountain, a random walk to the nearest sea, over the thesis's relief.
+    Thesis,
+    /// Beyond the thesis (docs/rivers.md): relief with ranges and valleys, water routed over the whole sphere,
+    /// rivers as trees that join at confluences and end in the sea or in lakes.
+    Drainage,
+}
+
 /// `<river-attributes>`: Table 6.1 plus the river-generation parameters of Chapter 5.
 #[derive(Clone, Debug, Serialize)]
 pub struct RiverConfig {
+    pub model: RiverModel,
+    /// Drainage model: the drainage area (world units squared) at which a river begins.
+    pub source_area: f32,
+    /// Drainage model: how deep a depression must be (height units) to be kept as a lake.
+    pub lake_depth: f32,
     pub influence_distance: f32,
     pub basin_depth: f32,
     pub basin_water_offset: f32,
@@ -140,6 +156,9 @@ impl Default for Config {
                 base_resolution: 129,
             },
             river: RiverConfig {
+                model: RiverModel::Thesis,
+                source_area: 20000.0,
+                lake_depth: 0.5,
                 influence_distance: 20.0,
                 basin_depth: 0.1,
                 basin_water_offset: 0.001,
@@ -201,6 +220,9 @@ struct RawPlanet {
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct RawRiver {
+    river_model: Option<String>,
+    source_area: Option<String>,
+    lake_depth: Option<String>,
     influence_distance: Option<String>,
     basin_depth: Option<String>,
     basin_water_offset: Option<String>,
@@ -333,6 +355,30 @@ impl Reader<'_> {
             "false" | "0" | "no" => Ok(false),
             _ => Err(self.error(element, text, "must be true or false")),
         }
+    }
+
+    /// One of the names in `options`.
+    fn choice<T: Copy>(
+        &self,
+        element: &str,
+        raw: &Option<String>,
+        default: T,
+        options: &[(&str, T)],
+    ) -> Result<T, ConfigError> {
+        let Some(text) = raw else { return Ok(default) };
+        let name = clean(text).to_ascii_lowercase();
+        options
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| *v)
+            .ok_or_else(|| {
+                let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
+                self.error(
+                    element,
+                    text,
+                    format!("must be one of {}", names.join(", ")),
+                )
+            })
     }
 
     /// A whole number of the form 2^n + 1 within [min, max].
@@ -493,6 +539,22 @@ impl Config {
         let v = raw.river_attributes.unwrap_or_default();
         let dv = &d.river;
         let river = RiverConfig {
+            model: r.choice(
+                "river-model",
+                &v.river_model,
+                dv.model,
+                &[
+                    ("thesis", RiverModel::Thesis),
+                    ("drainage", RiverModel::Drainage),
+                ],
+            )?,
+            source_area: r.f32(
+                "source-area",
+                &v.source_area,
+                dv.source_area,
+                Range::Positive,
+            )?,
+            lake_depth: r.f32("lake-depth", &v.lake_depth, dv.lake_depth, Range::Positive)?,
             influence_distance: r.f32(
                 "influence-distance",
                 &v.influence_distance,

@@ -737,6 +737,15 @@ fn generate(
     value["tributaries"] = serde_json::json!(tributaries);
     value["abandoned_river_sources"] = serde_json::json!(network.abandoned_sources);
     value["rivers_geojson_lod"] = serde_json::json!(geojson_depth);
+    if let Some(drainage) = &planet.drainage {
+        // The drainage model's measures, at the top level (docs/rivers.md).
+        if let serde_json::Value::Object(measures) = serde_json::to_value(&drainage.measures)? {
+            for (key, v) in measures {
+                value[key] = v;
+            }
+        }
+        value["river_systems"] = serde_json::json!(rivers);
+    }
     let path = out.join("stats.json");
     std::fs::write(&path, serde_json::to_string_pretty(&value)?)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;

@@ -111,6 +111,7 @@ fn a_pit_becomes_a_lake_at_its_spill_height_and_rivers_form_trees() {
         Thresholds {
             river_area: 0.01,
             lake_depth: 10.0,
+            min_source_nodes: 3,
         },
     );
     let m = &network.measures;

@@ -3,7 +3,7 @@
 //! cube key), linked to its eight neighbours on every face that holds it. Flow thus crosses face borders like
 //! any other step, with no seam.
 
-use std::collections::HashMap;
+use std::{cmp::Reverse, collections::BinaryHeap, collections::HashMap};
 
 use glam::{DVec3, I64Vec3};
 
@@ -114,6 +114,33 @@ impl SphereGrid {
         out
     }
 
+    /// For every node, the angle to the nearest of `sources` along the grid (Dijkstra over neighbour steps) and
+    /// which source that is; `f64::INFINITY` and `u32::MAX` beyond `limit`.
+    pub fn nearest(&self, sources: &[u32], limit: f64) -> (Vec<f64>, Vec<u32>) {
+        let mut distance = vec![f64::INFINITY; self.len()];
+        let mut from = vec![u32::MAX; self.len()];
+        let mut open = BinaryHeap::new();
+        for &s in sources {
+            distance[s as usize] = 0.0;
+            from[s as usize] = s;
+            open.push(Reverse((Ordered(0.0), s)));
+        }
+        while let Some(Reverse((Ordered(d), node))) = open.pop() {
+            if d > distance[node as usize] {
+                continue;
+            }
+            for &next in self.neighbours(node) {
+                let nd = d + self.angle(node, next);
+                if nd < distance[next as usize] && nd <= limit {
+                    distance[next as usize] = nd;
+                    from[next as usize] = from[node as usize];
+                    open.push(Reverse((Ordered(nd), next)));
+                }
+            }
+        }
+        (distance, from)
+    }
+
     /// Every quad of every face as its nodes: (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1).
     pub fn quads(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
         let (c, side) = (self.cells as usize, self.cells as usize + 1);
@@ -148,3 +175,18 @@ const NEIGHBOURS: [(i64, i64); 8] = [
     (0, 1),
     (1, 1),
 ];
+
+/// A finite f64 ordered for a priority queue.
+#[derive(PartialEq)]
+pub struct Ordered(pub f64);
+impl Eq for Ordered {}
+impl Ord for Ordered {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}

@@ -1,7 +1,158 @@
 //! Drainage networks (beyond the thesis; docs/rivers.md): water routed over the whole sphere at the base
-//! resolution, so rivers run downhill, join at confluences and end in the sea or in lakes. The thesis's rivers
-//! (one random walk per mountain, Chapter 5) stay selectable as `<river-model>thesis</river-model>`.
+//! resolution, so rivers run downhill, join at confluences and end in the sea or in lakes, and the terrain falls
+//! towards them in valleys. The thesis's rivers (one random walk per mountain, Chapter 5) stay selectable as
+//! `<river-model>thesis</river-model>`.
 
 pub mod grid;
 pub mod rivers;
 pub mod routing;
+pub mod valleys;
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::{
+    config::{PlanetConfig, RiverConfig},
+    planet::heights::FaceLattice,
+};
+use grid::SphereGrid;
+use rivers::{extract, DrainageMeasures, Thresholds};
+use routing::route;
+
+/// Nodes a first-order stream needs before it joins another river (see [`rivers::Thresholds`]).
+pub const MIN_SOURCE_NODES: usize = 0;
+
+/// One reach as the river model needs it: points on the unit sphere in flow order, with the bed height and the
+/// drainage area (world units squared) at each.
+#[derive(Clone, Debug)]
+pub struct ReachPath {
+    pub points: Vec<DVec3>,
+    pub beds: Vec<f32>,
+    pub areas: Vec<f64>,
+    pub strahler: u32,
+    /// The reach this one flows into (an index into [`Drainage::reaches`]); `None` at a mouth.
+    pub downstream: Option<usize>,
+    /// Whether the reach ends in a lake rather than the sea or another reach.
+    pub into_lake: bool,
+}
+
+/// A lake: the directions of its nodes and its water level.
+#[derive(Clone, Debug, Serialize)]
+pub struct LakeShape {
+    #[serde(skip)]
+    pub points: Vec<DVec3>,
+    pub level: f32,
+    /// Area on the sphere, world units squared.
+    pub area: f64,
+}
+
+/// The drained planet: its reaches, lakes and measures.
+#[derive(Clone, Debug, Default)]
+pub struct Drainage {
+    pub reaches: Vec<ReachPath>,
+    pub lakes: Vec<LakeShape>,
+    pub measures: DrainageMeasures,
+    /// The largest drainage area of any river node (world units squared): widths scale against it.
+    pub largest_area: f64,
+}
+
+/// Routes the water of `lattice` (the base heights), extracts rivers and lakes, and carves valleys into
+/// `lattice` around the rivers.
+pub fn drain(
+    lattice: &mut FaceLattice,
+    grid: &SphereGrid,
+    planet: &PlanetConfig,
+    river: &RiverConfig,
+) -> Drainage {
+    let heights = grid.values(lattice);
+    let sea_level = planet.sea_level_height as f64;
+    let radius = planet.radius as f64;
+    let routing = route(grid, &heights, sea_level);
+    let network = extract(
+        grid,
+        &routing,
+        &heights,
+        sea_level,
+        Thresholds {
+            river_area: river.source_area as f64 / (radius * radius),
+            lake_depth: river.lake_depth as f64,
+            min_source_nodes: MIN_SOURCE_NODES,
+        },
+    );
+    let carved = valleys::carve(grid, &routing, &network, &heights, sea_level);
+    grid.write(&carved, lattice);
+    let r2 = radius * radius;
+    let reaches: Vec<ReachPath> = network
+        .reaches
+        .iter()
+        .map(|reach| ReachPath {
+            points: reach
+                .nodes
+                .iter()
+                .map(|&k| grid.directions[k as usize])
+                .collect(),
+            beds: beds(reach, &carved, &network, sea_level),
+            areas: reach
+                .nodes
+                .iter()
+                .map(|&k| routing.area[k as usize] * r2)
+                .collect(),
+            strahler: reach.strahler,
+            downstream: reach.downstream,
+            into_lake: reach
+                .nodes
+                .last()
+                .is_some_and(|&k| network.lake_of[k as usize].is_some()),
+        })
+        .collect();
+    let largest_area = reaches
+        .iter()
+        .flat_map(|r| r.areas.iter().copied())
+        .fold(0.0, f64::max);
+    let lakes = network
+        .lakes
+        .iter()
+        .map(|lake| LakeShape {
+            points: lake
+                .nodes
+                .iter()
+                .map(|&k| grid.directions[k as usize])
+                .collect(),
+            level: lake.level as f32,
+            area: lake
+                .nodes
+                .iter()
+                .map(|&k| grid.areas[k as usize])
+                .sum::<f64>()
+                * r2,
+        })
+        .collect();
+    Drainage {
+        reaches,
+        lakes,
+        measures: network.measures,
+        largest_area,
+    }
+}
+
+/// Bed heights along a reach: the carved terrain at its river nodes; at a mouth the sea level or the lake's level;
+/// never rising downstream.
+fn beds(
+    reach: &rivers::Reach,
+    carved: &[f64],
+    network: &rivers::DrainageNetwork,
+    sea_level: f64,
+) -> Vec<f32> {
+    let mut out: Vec<f32> = Vec::with_capacity(reach.nodes.len());
+    for &k in &reach.nodes {
+        let k = k as usize;
+        let h = match network.lake_of[k] {
+            Some(lake) => network.lakes[lake as usize].level,
+            None if carved[k] <= sea_level => sea_level,
+            None => carved[k],
+        };
+        let h = h as f32;
+        out.push(out.last().map_or(h, |&above: &f32| above.min(h)));
+    }
+    out
+}

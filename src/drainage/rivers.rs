@@ -39,6 +39,8 @@ pub struct DrainageMeasures {
     pub confluences: usize,
     pub lakes: usize,
     pub strahler_max: u32,
+    /// Strahler streams of each order (index 0: order 1).
+    pub streams_per_order: Vec<usize>,
     /// Horton's bifurcation ratio: exp(-slope) of the least-squares line through ln(streams of order w) over w.
     pub bifurcation_ratio: f64,
     /// Hack's exponent: least-squares slope of ln(main-stream length) over ln(drainage area) at the lower end of
@@ -68,6 +70,8 @@ pub struct Thresholds {
     pub river_area: f64,
     /// Depth a depression needs to be kept as a lake.
     pub lake_depth: f64,
+    /// First-order streams shorter than this many nodes that join another river are dropped.
+    pub min_source_nodes: usize,
 }
 
 /// Extracts rivers and lakes from `routing` over `heights` (the unfilled heights; nodes at or below `sea_level`
@@ -82,15 +86,21 @@ pub fn extract(
     let n = grid.len();
     let sea = |k: usize| heights[k] <= sea_level;
     let (lakes, lake_of) = lakes(grid, routing, heights, sea_level, thresholds.lake_depth);
-    let river: Vec<bool> = (0..n)
+    let mut river: Vec<bool> = (0..n)
         .map(|k| !sea(k) && lake_of[k].is_none() && routing.area[k] >= thresholds.river_area)
         .collect();
-    let mut donors = vec![0u32; n];
-    for (k, &r) in routing.receiver.iter().enumerate() {
-        if river[k] && r != NONE {
-            donors[r as usize] += 1;
+    let count_donors = |river: &[bool]| {
+        let mut donors = vec![0u32; n];
+        for (k, &r) in routing.receiver.iter().enumerate() {
+            if river[k] && r != NONE {
+                donors[r as usize] += 1;
+            }
         }
-    }
+        donors
+    };
+    let before = count_donors(&river);
+    prune_short_sources(routing, &mut river, &before, thresholds.min_source_nodes);
+    let donors = count_donors(&river);
     // Reaches start at heads and confluences, upstream first, so a reach comes after every reach that joins it.
     let mut reaches: Vec<Reach> = Vec::new();
     let mut starting_at = vec![u32::MAX; n];
@@ -155,6 +165,33 @@ pub fn extract(
         reaches,
         lakes,
         lake_of,
+    }
+}
+
+/// Drops the first-order streams that join another river within `min_nodes` nodes of their head: on a lattice,
+/// drainage area passes the threshold beside every larger river, and these one- or two-cell side channels are
+/// artefacts of the threshold, not streams (the usual minimum source length of channel extraction).
+fn prune_short_sources(routing: &Routing, river: &mut [bool], donors: &[u32], min_nodes: usize) {
+    let heads: Vec<usize> = (0..river.len())
+        .filter(|&k| river[k] && donors[k] == 0)
+        .collect();
+    for head in heads {
+        let mut path = vec![head];
+        let mut at = head;
+        while path.len() < min_nodes {
+            let r = routing.receiver[at];
+            if r == NONE || !river[r as usize] {
+                break;
+            }
+            if donors[r as usize] >= 2 {
+                for &k in &path {
+                    river[k] = false;
+                }
+                break;
+            }
+            at = r as usize;
+            path.push(at);
+        }
     }
 }
 
@@ -303,6 +340,7 @@ fn measure(
         confluences: 0,
         lakes: 0,
         strahler_max,
+        streams_per_order: streams[1..].to_vec(),
         bifurcation_ratio: (-slope(&horton)).exp(),
         hack_exponent: slope(&hack),
         drained_land_fraction: if land > 0.0 { drained_land / land } else { 0.0 },

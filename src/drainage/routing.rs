@@ -4,7 +4,7 @@
 
 use std::{cmp::Reverse, collections::BinaryHeap};
 
-use super::grid::SphereGrid;
+use super::grid::{Ordered, SphereGrid};
 
 /// `receiver` of a node that drains nowhere (the sea).
 pub const NONE: u32 = u32::MAX;
@@ -26,21 +26,6 @@ pub struct Routing {
     pub crossing: usize,
 }
 
-/// An f64 height ordered for the heap (heights are finite).
-#[derive(PartialEq)]
-struct Height(f64);
-impl Eq for Height {}
-impl Ord for Height {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&other.0)
-    }
-}
-impl PartialOrd for Height {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
 /// Routes `heights` (one per grid node) to the sea: nodes at or below `sea_level` are outlets.
 pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
     let n = grid.len();
@@ -55,19 +40,19 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
     for k in 0..n {
         if heights[k] <= sea_level {
             closed[k] = true;
-            open.push(Reverse((Height(heights[k]), k as u32)));
+            open.push(Reverse((Ordered(heights[k]), k as u32)));
         }
     }
     // Nodes leave the queue in order of their filled height, so every node comes after the nodes below it.
     let mut downstream_first = Vec::with_capacity(n);
-    while let Some(Reverse((Height(h), node))) = open.pop() {
+    while let Some(Reverse((Ordered(h), node))) = open.pop() {
         downstream_first.push(node);
         for &next in grid.neighbours(node) {
             if !closed[next as usize] {
                 closed[next as usize] = true;
                 let f = heights[next as usize].max(h + epsilon);
                 filled[next as usize] = f;
-                open.push(Reverse((Height(f), next)));
+                open.push(Reverse((Ordered(f), next)));
             }
         }
     }

@@ -6,6 +6,8 @@ pub mod continents;
 pub mod cube;
 pub mod detail;
 pub mod heights;
+pub mod noise;
+pub mod relief;
 
 use std::{path::Path, time::Instant};
 
@@ -20,7 +22,11 @@ use self::{
     detail::{DetailRule, PatchHeights},
     heights::{area_weight, FaceLattice},
 };
-use crate::{config::Config, rng::Rng};
+use crate::{
+    config::{Config, RiverModel},
+    drainage::{self, grid::SphereGrid, Drainage},
+    rng::Rng,
+};
 
 const STREAM_MOUNTAINS: u64 = 0x40_0001;
 
@@ -107,6 +113,8 @@ pub struct Planet {
     bounds: Vec<Vec<(f32, f32)>>,
     pub mountains: Vec<Mountain>,
     pub features: Option<FeaturePoints>,
+    /// The rivers and lakes of the drainage model (`None` for the thesis's model).
+    pub drainage: Option<Drainage>,
     pub stats: PlanetStats,
 }
 
@@ -194,6 +202,8 @@ impl Planet {
         let mut requested = target;
         let total: f64 = weights.iter().sum();
         let mut attempt = 0;
+        let drainage_model = config.river.model == RiverModel::Drainage;
+        let grid = drainage_model.then(|| SphereGrid::new(&FaceLattice::new(base_cells, 0.0)));
         loop {
             let t = Instant::now();
             let (land, weight) = match &image_land {
@@ -229,9 +239,24 @@ impl Planet {
                     p.ocean_height
                 };
             }
-            let mountains = seed_mountains(&mut base, config, seed64);
-            time("mountains", t);
-            progress("mountains");
+            let (mountains, drainage) = match &grid {
+                None => {
+                    let mountains = seed_mountains(&mut base, config, seed64);
+                    time("mountains", t);
+                    progress("mountains");
+                    (mountains, None)
+                }
+                Some(grid) => {
+                    relief::raise(&mut base, grid, p, seed64);
+                    time("relief", t);
+                    progress("relief");
+                    let t = Instant::now();
+                    let drainage = drainage::drain(&mut base, grid, p, &config.river);
+                    time("drainage", t);
+                    progress("drainage");
+                    (Vec::new(), Some(drainage))
+                }
+            };
 
             let t = Instant::now();
             let heights =
@@ -246,7 +271,7 @@ impl Planet {
                 break Ok(Self::finish(
                     config,
                     (heights, precomputed_level, rule),
-                    mountains,
+                    (mountains, drainage),
                     features,
                     PlanetStats {
                         seed,
@@ -276,7 +301,7 @@ impl Planet {
     fn finish(
         config: &Config,
         (lattice, precomputed_level, rule): (FaceLattice, u32, DetailRule),
-        mountains: Vec<Mountain>,
+        (mountains, drainage): (Vec<Mountain>, Option<Drainage>),
         features: Option<FeaturePoints>,
         mut stats: PlanetStats,
     ) -> Self {
@@ -295,6 +320,7 @@ impl Planet {
             bounds,
             mountains,
             features,
+            drainage,
             stats,
         }
     }

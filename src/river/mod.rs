@@ -1,5 +1,6 @@
 //! River networks (Chapter 5) and their samples (Section 6.4).
 
+pub mod drainage;
 pub mod hull;
 pub mod network;
 pub mod samples;

@@ -40,7 +40,7 @@ pub struct RiverFrame {
 }
 
 impl RiverFrame {
-    fn new(centre: DVec3, towards: DVec3, radius: f64) -> Self {
+    pub fn new(centre: DVec3, towards: DVec3, radius: f64) -> Self {
         let e1 = (towards - centre * towards.dot(centre)).normalize();
         Self {
             centre,
@@ -333,9 +333,26 @@ impl RiverNetwork {
     /// direction until the base terrain is no longer land; the Hermite tangents are end minus start, the start one
     /// rotated by 15-45 degrees, the end one flowing straight into the sea. A river whose hull meets another
     /// system's hull tries another direction, up to `max-attempts`.
+    ///
+    /// With the drainage model, the systems are the planet's drainage network instead ([`super::drainage`]).
     pub fn generate(planet: &Planet, config: &Config, seed: u32) -> Self {
         let params = SubdivisionParams::from_config(config, seed as u64);
         let r = &config.river;
+        let network = |systems, abandoned_sources| Self {
+            systems,
+            params,
+            hull_levels: r.hull_levels,
+            influence_distance: r.influence_distance as f64,
+            samples_per_half_width: r.samples_per_half_width,
+            samples_per_vertex_spacing: r.samples_per_vertex_spacing,
+            abandoned_sources,
+        };
+        if let Some(drainage) = &planet.drainage {
+            return network(
+                super::drainage::systems(drainage, planet.radius, config, &params),
+                0,
+            );
+        }
         let step = (0.25f64).to_radians();
         let mut systems: Vec<RiverSystem> = Vec::new();
         let mut abandoned = 0;
@@ -365,15 +382,7 @@ impl RiverNetwork {
                 abandoned += 1;
             }
         }
-        Self {
-            systems,
-            params,
-            hull_levels: r.hull_levels,
-            influence_distance: r.influence_distance as f64,
-            samples_per_half_width: r.samples_per_half_width,
-            samples_per_vertex_spacing: r.samples_per_vertex_spacing,
-            abandoned_sources: abandoned,
-        }
+        network(systems, abandoned)
     }
 
     /// Rivers and tributaries down to `depth`.
@@ -459,6 +468,20 @@ fn build_system(
             }
         })
         .collect();
+    enclose(config, params, id, frame, segments, (source, mouth))
+}
+
+/// A system of `segments` in `frame`: its hull over `hull-levels` levels of subdivision, tributaries included
+/// (5.2.3), and the hull extended by the influence distance and by how far deeper levels can stray (6.3).
+pub fn enclose(
+    config: &Config,
+    params: &SubdivisionParams,
+    id: u32,
+    frame: RiverFrame,
+    segments: Vec<Segment>,
+    (source, mouth): (DVec3, DVec3),
+) -> RiverSystem {
+    let r = &config.river;
     let pieces = pieces_to_depth(&segments, r.hull_levels, params);
     let points: Vec<DVec2> = pieces
         .iter()

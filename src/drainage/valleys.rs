@@ -1,0 +1,58 @@
+//! Valleys around the rivers (drainage model): the terrain near a river falls towards the river's bed, over a
+//! half-width that grows with the river's drainage area, so rivers lie in valleys rather than in trenches at every
+//! level of detail (the finer levels refine the carved base heights).
+
+use super::{grid::SphereGrid, rivers::DrainageNetwork, routing::Routing};
+
+/// Half-width of the smallest river's valley, in base lattice cells.
+const NARROWEST: f64 = 1.5;
+/// Half-width of the largest river's valley, in base lattice cells.
+const WIDEST: f64 = 4.0;
+
+/// The heights with valleys carved: a river node sits at its bed (the filled height, which never rises
+/// downstream); a node within a valley's half-width `w` at distance `d` of its nearest river node keeps its height
+/// above that bed scaled by `(d / w)^2`, never raised.
+/// Sea and lake nodes keep their heights.
+pub fn carve(
+    grid: &SphereGrid,
+    routing: &Routing,
+    network: &DrainageNetwork,
+    heights: &[f64],
+    sea_level: f64,
+) -> Vec<f64> {
+    let dry = |k: usize| heights[k] > sea_level && network.lake_of[k].is_none();
+    let cell = std::f64::consts::FRAC_PI_2 / grid.cells as f64;
+    let river_nodes: Vec<u32> = network
+        .reaches
+        .iter()
+        .flat_map(|r| r.nodes.iter().copied())
+        .filter(|&k| dry(k as usize))
+        .collect();
+    let largest = river_nodes
+        .iter()
+        .map(|&k| routing.area[k as usize])
+        .fold(0.0, f64::max);
+    let half_width = |k: u32| {
+        let share = (routing.area[k as usize] / largest).sqrt();
+        cell * (NARROWEST + (WIDEST - NARROWEST) * share)
+    };
+    let (distance, nearest) = grid.nearest(&river_nodes, WIDEST * cell);
+    let mut out = heights.to_vec();
+    for k in 0..grid.len() {
+        let source = nearest[k];
+        if source == u32::MAX || !dry(k) {
+            continue;
+        }
+        let bed = routing.filled[source as usize];
+        if source == k as u32 {
+            out[k] = bed;
+            continue;
+        }
+        let w = half_width(source);
+        if distance[k] < w && heights[k] > bed {
+            let t = distance[k] / w;
+            out[k] = bed + (heights[k] - bed) * t * t;
+        }
+    }
+    out
+}

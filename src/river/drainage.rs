@@ -1,0 +1,152 @@
+//! River systems from a drainage network (drainage model, beyond the thesis; docs/rivers.md): every reach becomes
+//! Hermite segments through its nodes, with widths from its drainage area and its bed heights, so that everything
+//! downstream (LoD subdivision 5.2.2, procedural tributaries 5.2.3, hulls 6.3, samples 6.4, the kernel) works on
+//! them as on the thesis's rivers.
+
+use glam::{DVec2, DVec3};
+
+use super::{
+    network::{enclose, RiverFrame, RiverSystem, Segment, SubdivisionParams},
+    spline::Hermite,
+};
+use crate::{config::Config, drainage::Drainage, rng};
+
+/// Largest angle between a system's anchor (where it ends) and any of its points; reaches beyond it start a
+/// system of their own, so that the gnomonic frame stays within a few percent of true distances.
+const SYSTEM_ANGLE: f64 = 0.3;
+/// Lattice nodes per Hermite segment.
+const NODES_PER_SEGMENT: usize = 2;
+
+/// The river systems of `drainage`: each mouth's tree, split where it grows beyond [`SYSTEM_ANGLE`]; the system
+/// of the largest river first.
+pub fn systems(
+    drainage: &Drainage,
+    radius: f64,
+    config: &Config,
+    params: &SubdivisionParams,
+) -> Vec<RiverSystem> {
+    let reaches = &drainage.reaches;
+    // Upstream reaches of each reach, and the system (anchor reach) each reach joins, downstream first.
+    let mut upstream: Vec<Vec<usize>> = vec![Vec::new(); reaches.len()];
+    for (k, r) in reaches.iter().enumerate() {
+        if let Some(d) = r.downstream {
+            upstream[d].push(k);
+        }
+    }
+    let mut anchor = vec![usize::MAX; reaches.len()];
+    let mut stack: Vec<usize> = (0..reaches.len())
+        .filter(|&k| reaches[k].downstream.is_none())
+        .collect();
+    for &root in &stack {
+        anchor[root] = root;
+    }
+    while let Some(k) = stack.pop() {
+        for &u in &upstream[k] {
+            let own = anchor[k];
+            let end = *reaches[own].points.last().unwrap();
+            let fits = reaches[u]
+                .points
+                .iter()
+                .all(|p| crate::planet::cube::angle(*p, end) <= SYSTEM_ANGLE);
+            anchor[u] = if fits { own } else { u };
+            stack.push(u);
+        }
+    }
+    let r = &config.river;
+    let widest = r.starting_width * r.ending_factor.max(1.0);
+    let width = |area: f64| {
+        let share = (area / drainage.largest_area.max(f64::MIN_POSITIVE)).sqrt() as f32;
+        r.min_width + (widest - r.min_width) * share.clamp(0.0, 1.0)
+    };
+    let branch = |k: usize| rng::hash(params.seed, &[0x6472_6169, k as u64]);
+    let mut roots: Vec<usize> = (0..reaches.len()).filter(|&k| anchor[k] == k).collect();
+    let mouth_area = |k: usize| reaches[k].areas.last().copied().unwrap_or(0.0);
+    roots.sort_by(|a, b| mouth_area(*b).total_cmp(&mouth_area(*a)));
+    roots
+        .iter()
+        .enumerate()
+        .map(|(id, &root)| {
+            let members: Vec<usize> = (0..reaches.len()).filter(|&k| anchor[k] == root).collect();
+            let mouth = *reaches[root].points.last().unwrap();
+            let source = trunk_head(drainage, &upstream, root);
+            let frame = RiverFrame::new(mouth, source, radius);
+            let plane = |p: DVec3| frame.to_plane(p).unwrap_or_default();
+            let mut segments = Vec::new();
+            for &k in &members {
+                let reach = &reaches[k];
+                let points: Vec<DVec2> = reach.points.iter().map(|p| plane(*p)).collect();
+                // Where the reach joins another, it leaves along the other's first direction: C1 at the
+                // confluence (5.2.3).
+                let joins = reach.downstream.map(|d| {
+                    reaches[d]
+                        .points
+                        .iter()
+                        .map(|p| plane(*p))
+                        .collect::<Vec<_>>()
+                });
+                let knots: Vec<usize> = knot_indices(points.len());
+                for (s, pair) in knots.windows(2).enumerate() {
+                    let (a, b) = (pair[0], pair[1]);
+                    let tangent = |i: usize| tangent_at(&points, &knots, i, joins.as_deref());
+                    let span = (b - a) as f64;
+                    segments.push(Segment {
+                        curve: Hermite {
+                            p0: points[a],
+                            d0: tangent(a) * span,
+                            p1: points[b],
+                            d1: tangent(b) * span,
+                        },
+                        heights: (reach.beds[a], reach.beds[b]),
+                        widths: (width(reach.areas[a]), width(reach.areas[b])),
+                        key: rng::hash(branch(k), &[s as u64]),
+                        depth: 0,
+                        generation: 0,
+                        branch: branch(k),
+                        parent_branch: reach.downstream.map(branch),
+                    });
+                }
+            }
+            enclose(config, params, id as u32, frame, segments, (source, mouth))
+        })
+        .collect()
+}
+
+/// The head of the longest chain of reaches above `root` by drainage area (the main stem).
+fn trunk_head(drainage: &Drainage, upstream: &[Vec<usize>], root: usize) -> DVec3 {
+    let mut at = root;
+    while let Some(&next) = upstream[at].iter().max_by(|a, b| {
+        let area = |k: usize| drainage.reaches[k].areas.last().copied().unwrap_or(0.0);
+        area(**a).total_cmp(&area(**b))
+    }) {
+        at = next;
+    }
+    drainage.reaches[at].points[0]
+}
+
+/// Every [`NODES_PER_SEGMENT`]-th node, and the last.
+fn knot_indices(len: usize) -> Vec<usize> {
+    let mut knots: Vec<usize> = (0..len).step_by(NODES_PER_SEGMENT).collect();
+    if knots.last() != Some(&(len - 1)) {
+        knots.push(len - 1);
+    }
+    knots
+}
+
+/// The flow direction per node spacing at node `i` of a reach (Catmull-Rom between its neighbouring nodes); at
+/// the last node of a reach that joins another, the other's direction at its first node.
+fn tangent_at(points: &[DVec2], knots: &[usize], i: usize, joins: Option<&[DVec2]>) -> DVec2 {
+    let last = points.len() - 1;
+    let own = if i == 0 {
+        points[1] - points[0]
+    } else if i == last {
+        points[last] - points[last - 1]
+    } else {
+        (points[i + 1] - points[i - 1]) * 0.5
+    };
+    match joins {
+        Some(next) if i == last && next.len() > 1 && i == *knots.last().unwrap() => {
+            (next[1] - next[0]).normalize_or_zero() * own.length()
+        }
+        _ => own,
+    }
+}
