@@ -111,7 +111,6 @@ fn a_pit_becomes_a_lake_at_its_spill_height_and_rivers_form_trees() {
         Thresholds {
             river_area: 0.01,
             lake_depth: 10.0,
-            min_source_nodes: 3,
         },
     );
     let m = &network.measures;
@@ -139,4 +138,72 @@ fn a_pit_becomes_a_lake_at_its_spill_height_and_rivers_form_trees() {
         }
     }
     assert!(m.drained_land_fraction > 0.0 && m.drained_land_fraction <= 1.0);
+}
+
+fn drainage_config() -> riverplanet::config::Config {
+    riverplanet::config::Config::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/drainage.xml"),
+    )
+    .unwrap()
+}
+
+/// The network measures of a planet against the laws of real river networks (Horton, Hack) and the model's
+/// own guarantees (no bed rising downstream, no crossing).
+fn assert_natural(config: &riverplanet::config::Config, seed: u32) {
+    let planet = riverplanet::planet::Planet::generate(config, seed, |_| {}).unwrap();
+    let d = planet
+        .drainage
+        .as_ref()
+        .expect("the drainage model drains the planet");
+    let m = &d.measures;
+    println!("seed {seed}: {m:?}");
+    assert!(m.strahler_max >= 4, "seed {seed}: {m:?}");
+    assert!(
+        (3.0..=5.0).contains(&m.bifurcation_ratio),
+        "seed {seed}: {m:?}"
+    );
+    assert!(
+        (0.45..=0.7).contains(&m.hack_exponent),
+        "seed {seed}: {m:?}"
+    );
+    assert!(m.drained_land_fraction >= 0.6, "seed {seed}: {m:?}");
+    assert_eq!(m.uphill_steps, 0);
+    assert_eq!(m.crossings, 0);
+    assert!(m.confluences > 100 && m.rivers > 10);
+    // Beds never rise downstream, within a reach or into the next.
+    for reach in &d.reaches {
+        assert!(reach.beds.windows(2).all(|w| w[1] <= w[0]));
+        if let Some(next) = reach.downstream {
+            assert!(d.reaches[next].beds[0] <= *reach.beds.last().unwrap());
+        }
+    }
+}
+
+#[test]
+fn drained_planets_follow_horton_and_hack_on_seeds_1_2_3() {
+    let config = drainage_config();
+    for seed in 1..=3 {
+        assert_natural(&config, seed);
+    }
+}
+
+#[test]
+fn drained_planets_follow_horton_and_hack_from_the_image_continents() {
+    let mut config = drainage_config();
+    config.planet.continents_from_file = true;
+    config.planet.continents_image = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("config/continents.png")
+        .to_string_lossy()
+        .into_owned();
+    assert_natural(&config, 1);
+}
+
+#[test]
+fn the_thesis_model_stays_selectable() {
+    let mut config = drainage_config();
+    config.river.model = riverplanet::config::RiverModel::Thesis;
+    let world = riverplanet::world::World::build(&config, 1).unwrap();
+    assert!(world.planet.drainage.is_none());
+    assert!(!world.planet.mountains.is_empty());
+    assert!(!world.network.systems.is_empty());
 }

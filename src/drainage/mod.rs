@@ -19,9 +19,6 @@ use grid::SphereGrid;
 use rivers::{extract, DrainageMeasures, Thresholds};
 use routing::route;
 
-/// Nodes a first-order stream needs before it joins another river (see [`rivers::Thresholds`]).
-pub const MIN_SOURCE_NODES: usize = 0;
-
 /// One reach as the river model needs it: points on the unit sphere in flow order, with the bed height and the
 /// drainage area (world units squared) at each.
 #[derive(Clone, Debug)]
@@ -76,7 +73,6 @@ pub fn drain(
         Thresholds {
             river_area: river.source_area as f64 / (radius * radius),
             lake_depth: river.lake_depth as f64,
-            min_source_nodes: MIN_SOURCE_NODES,
         },
     );
     let carved = valleys::carve(grid, &routing, &network, &heights, sea_level);

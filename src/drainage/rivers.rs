@@ -39,9 +39,10 @@ pub struct DrainageMeasures {
     pub confluences: usize,
     pub lakes: usize,
     pub strahler_max: u32,
-    /// Strahler streams of each order (index 0: order 1).
+    /// Strahler streams of each order (index 0: order 1) in the basins of order [`HORTON_BASIN_ORDER`] and more.
     pub streams_per_order: Vec<usize>,
-    /// Horton's bifurcation ratio: exp(-slope) of the least-squares line through ln(streams of order w) over w.
+    /// Horton's bifurcation ratio: exp(-slope) of the least-squares line through ln(streams of order w) over w,
+    /// in the basins of order [`HORTON_BASIN_ORDER`] and more.
     pub bifurcation_ratio: f64,
     /// Hack's exponent: least-squares slope of ln(main-stream length) over ln(drainage area) at the lower end of
     /// every reach.
@@ -53,6 +54,9 @@ pub struct DrainageMeasures {
     /// Lattice quads whose two diagonals both carry a river (two rivers crossing).
     pub crossings: usize,
 }
+
+/// Basins of this outlet order and more are pooled for Horton's bifurcation ratio.
+pub const HORTON_BASIN_ORDER: u32 = 3;
 
 /// What the routing makes of a planet's heights.
 pub struct DrainageNetwork {
@@ -70,8 +74,6 @@ pub struct Thresholds {
     pub river_area: f64,
     /// Depth a depression needs to be kept as a lake.
     pub lake_depth: f64,
-    /// First-order streams shorter than this many nodes that join another river are dropped.
-    pub min_source_nodes: usize,
 }
 
 /// Extracts rivers and lakes from `routing` over `heights` (the unfilled heights; nodes at or below `sea_level`
@@ -86,21 +88,15 @@ pub fn extract(
     let n = grid.len();
     let sea = |k: usize| heights[k] <= sea_level;
     let (lakes, lake_of) = lakes(grid, routing, heights, sea_level, thresholds.lake_depth);
-    let mut river: Vec<bool> = (0..n)
+    let river: Vec<bool> = (0..n)
         .map(|k| !sea(k) && lake_of[k].is_none() && routing.area[k] >= thresholds.river_area)
         .collect();
-    let count_donors = |river: &[bool]| {
-        let mut donors = vec![0u32; n];
-        for (k, &r) in routing.receiver.iter().enumerate() {
-            if river[k] && r != NONE {
-                donors[r as usize] += 1;
-            }
+    let mut donors = vec![0u32; n];
+    for (k, &r) in routing.receiver.iter().enumerate() {
+        if river[k] && r != NONE {
+            donors[r as usize] += 1;
         }
-        donors
-    };
-    let before = count_donors(&river);
-    prune_short_sources(routing, &mut river, &before, thresholds.min_source_nodes);
-    let donors = count_donors(&river);
+    }
     // Reaches start at heads and confluences, upstream first, so a reach comes after every reach that joins it.
     let mut reaches: Vec<Reach> = Vec::new();
     let mut starting_at = vec![u32::MAX; n];
@@ -165,33 +161,6 @@ pub fn extract(
         reaches,
         lakes,
         lake_of,
-    }
-}
-
-/// Drops the first-order streams that join another river within `min_nodes` nodes of their head: on a lattice,
-/// drainage area passes the threshold beside every larger river, and these one- or two-cell side channels are
-/// artefacts of the threshold, not streams (the usual minimum source length of channel extraction).
-fn prune_short_sources(routing: &Routing, river: &mut [bool], donors: &[u32], min_nodes: usize) {
-    let heads: Vec<usize> = (0..river.len())
-        .filter(|&k| river[k] && donors[k] == 0)
-        .collect();
-    for head in heads {
-        let mut path = vec![head];
-        let mut at = head;
-        while path.len() < min_nodes {
-            let r = routing.receiver[at];
-            if r == NONE || !river[r as usize] {
-                break;
-            }
-            if donors[r as usize] >= 2 {
-                for &k in &path {
-                    river[k] = false;
-                }
-                break;
-            }
-            at = r as usize;
-            path.push(at);
-        }
     }
 }
 
@@ -273,14 +242,23 @@ fn measure(
     lake_of: &[Option<u32>],
 ) -> DrainageMeasures {
     let n = grid.len();
-    // Horton: a stream of order w starts where a reach of order w has no incoming reach of order w.
+    // Horton: a stream of order w starts where a reach of order w has no incoming reach of order w. Counted in
+    // the basins whose outlet has order HORTON_BASIN_ORDER or more (all basins if none has): Horton's law
+    // describes branched networks, and a coast's first- and second-order creeks have no branching to measure.
     let strahler_max = reaches.iter().map(|r| r.strahler).max().unwrap_or(0);
+    let outlet_order = |mut r: usize| {
+        while let Some(d) = reaches[r].downstream {
+            r = d;
+        }
+        reaches[r].strahler
+    };
+    let basin_order = HORTON_BASIN_ORDER.min(strahler_max);
     let mut streams = vec![0usize; strahler_max as usize + 1];
     for (r, reach) in reaches.iter().enumerate() {
-        if !incoming[r]
+        let starts = !incoming[r]
             .iter()
-            .any(|&u| reaches[u as usize].strahler == reach.strahler)
-        {
+            .any(|&u| reaches[u as usize].strahler == reach.strahler);
+        if starts && outlet_order(r) >= basin_order {
             streams[reach.strahler as usize] += 1;
         }
     }

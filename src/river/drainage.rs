@@ -14,6 +14,9 @@ use crate::{config::Config, drainage::Drainage, rng};
 /// Largest angle between a system's anchor (where it ends) and any of its points; reaches beyond it start a
 /// system of their own, so that the gnomonic frame stays within a few percent of true distances.
 const SYSTEM_ANGLE: f64 = 0.3;
+/// Subdivision levels in a drainage system's hull at most: its segments are a few lattice cells long already, and
+/// the extended hull's margin covers whatever finer levels add.
+const DRAINAGE_HULL_LEVELS: u32 = 1;
 /// Lattice nodes per Hermite segment.
 const NODES_PER_SEGMENT: usize = 2;
 
@@ -106,7 +109,15 @@ pub fn systems(
                     });
                 }
             }
-            enclose(config, params, id as u32, frame, segments, (source, mouth))
+            let hull_levels = config.river.hull_levels.min(DRAINAGE_HULL_LEVELS);
+            enclose(
+                config,
+                params,
+                (id as u32, hull_levels),
+                frame,
+                segments,
+                (source, mouth),
+            )
         })
         .collect()
 }

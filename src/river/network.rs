@@ -468,21 +468,28 @@ fn build_system(
             }
         })
         .collect();
-    enclose(config, params, id, frame, segments, (source, mouth))
+    enclose(
+        config,
+        params,
+        (id, r.hull_levels),
+        frame,
+        segments,
+        (source, mouth),
+    )
 }
 
-/// A system of `segments` in `frame`: its hull over `hull-levels` levels of subdivision, tributaries included
+/// A system of `segments` in `frame`: its hull over `hull_levels` levels of subdivision, tributaries included
 /// (5.2.3), and the hull extended by the influence distance and by how far deeper levels can stray (6.3).
 pub fn enclose(
     config: &Config,
     params: &SubdivisionParams,
-    id: u32,
+    (id, hull_levels): (u32, u32),
     frame: RiverFrame,
     segments: Vec<Segment>,
     (source, mouth): (DVec3, DVec3),
 ) -> RiverSystem {
     let r = &config.river;
-    let pieces = pieces_to_depth(&segments, r.hull_levels, params);
+    let pieces = pieces_to_depth(&segments, hull_levels, params);
     let points: Vec<DVec2> = pieces
         .iter()
         .flat_map(|p| p.curve.control_points())
@@ -490,7 +497,7 @@ pub fn enclose(
     let hull = hull::convex_hull(&points);
     let margin = pieces
         .iter()
-        .filter(|p| p.depth == r.hull_levels)
+        .filter(|p| p.depth == hull_levels)
         .map(|p| params.descendant_margin(p.polygon_length()) + p.widths.0.max(p.widths.1) as f64)
         .fold(0.0, f64::max);
     let extended = hull::extend(&hull, r.influence_distance as f64 + margin);
