@@ -709,7 +709,12 @@ fn generate(
     if preview {
         let path = out.join("preview.png");
         let mut image = riverplanet::export::preview(&planet, 256);
-        riverplanet::export::draw_rivers(&mut image, &network, geojson_depth, 256);
+        match &planet.drainage {
+            Some(drainage) => {
+                riverplanet::export::drainage::draw_drainage(&mut image, drainage, 256)
+            }
+            None => riverplanet::export::draw_rivers(&mut image, &network, geojson_depth, 256),
+        }
         image
             .save(&path)
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
@@ -721,7 +726,10 @@ fn generate(
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     }
     let path = out.join("rivers.geojson");
-    let geojson = riverplanet::export::rivers_geojson(&network, geojson_depth);
+    let geojson = match &planet.drainage {
+        Some(drainage) => riverplanet::export::drainage::drainage_geojson(drainage, &config),
+        None => riverplanet::export::rivers_geojson(&network, geojson_depth),
+    };
     std::fs::write(&path, serde_json::to_string(&geojson)?)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     let mut stats = planet.stats.clone();

@@ -181,3 +181,92 @@ fn the_ground_preset_reaches_deep_levels_made_on_demand() {
     assert!(deepest >= 11, "deepest level {deepest}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
+    let dir = temp_dir("generate-drainage");
+    let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/drainage.xml");
+    let run = riverplanet()
+        .args([
+            "generate",
+            "--seed",
+            "2",
+            "--level",
+            "3",
+            "--preview",
+            "--config",
+        ])
+        .arg(&config)
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("stats.json")).unwrap()).unwrap();
+    for key in [
+        "rivers",
+        "confluences",
+        "lakes",
+        "strahler_max",
+        "bifurcation_ratio",
+        "hack_exponent",
+        "drained_land_fraction",
+        "uphill_steps",
+        "crossings",
+    ] {
+        assert!(stats[key].is_number(), "stats.json lacks {key}: {stats}");
+    }
+    for stage in ["relief", "drainage", "rivers"] {
+        assert!(
+            stats["timings_ms"][stage].is_number(),
+            "no timing of {stage}"
+        );
+    }
+    let geojson: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("rivers.geojson")).unwrap()).unwrap();
+    let features = geojson["features"].as_array().unwrap();
+    let reaches: Vec<&serde_json::Value> = features
+        .iter()
+        .filter(|f| f["geometry"]["type"] == "LineString")
+        .collect();
+    let lakes = features.len() - reaches.len();
+    assert_eq!(lakes as u64, stats["lakes"].as_u64().unwrap());
+    assert!(reaches.len() > 100);
+    for reach in &reaches {
+        let p = &reach["properties"];
+        let id = p["id"].as_u64().unwrap();
+        assert!(p["strahler"].as_u64().unwrap() >= 1 && p["width"].as_f64().unwrap() > 0.0);
+        assert!(p["drainage_area"].as_f64().unwrap() > 0.0);
+        // Coordinates run downstream: the bed (third coordinate) never rises.
+        let beds: Vec<f64> = reach["geometry"]["coordinates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c[2].as_f64().unwrap())
+            .collect();
+        assert!(beds.windows(2).all(|w| w[1] <= w[0]), "reach {id} rises");
+        if let Some(down) = p["downstream"].as_u64() {
+            let next = reaches[down as usize];
+            assert_eq!(next["properties"]["id"].as_u64(), Some(down));
+            // It flows into the reach that starts where it ends.
+            let last = reach["geometry"]["coordinates"]
+                .as_array()
+                .unwrap()
+                .last()
+                .unwrap();
+            assert_eq!(&next["geometry"]["coordinates"][0], last);
+        }
+    }
+    let preview = image::open(dir.join("preview.png")).unwrap().to_rgb8();
+    // The largest rivers are drawn in the darkest order colours.
+    let dark = preview
+        .pixels()
+        .filter(|p| p.0 == [20, 60, 180] || p.0 == [30, 100, 220])
+        .count();
+    assert!(dark > 50, "{dark} pixels of order 4 or 5 rivers");
+}

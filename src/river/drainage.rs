@@ -55,12 +55,7 @@ pub fn systems(
             stack.push(u);
         }
     }
-    let r = &config.river;
-    let widest = r.starting_width * r.ending_factor.max(1.0);
-    let width = |area: f64| {
-        let share = (area / drainage.largest_area.max(f64::MIN_POSITIVE)).sqrt() as f32;
-        r.min_width + (widest - r.min_width) * share.clamp(0.0, 1.0)
-    };
+    let width = |area: f64| reach_width(config, drainage, area);
     let branch = |k: usize| rng::hash(params.seed, &[0x6472_6169, k as u64]);
     let mut roots: Vec<usize> = (0..reaches.len()).filter(|&k| anchor[k] == k).collect();
     let mouth_area = |k: usize| reaches[k].areas.last().copied().unwrap_or(0.0);
@@ -120,6 +115,16 @@ pub fn systems(
             )
         })
         .collect()
+}
+
+/// Hydraulic geometry: a river's full width grows with the square root of its discharge, taken as proportional
+/// to its drainage area, from `min-width` at no area to the widest river (`starting-width x ending-factor`) at
+/// the planet's largest drainage area.
+pub fn reach_width(config: &Config, drainage: &Drainage, area: f64) -> f32 {
+    let r = &config.river;
+    let widest = r.starting_width * r.ending_factor.max(1.0);
+    let share = (area / drainage.largest_area.max(f64::MIN_POSITIVE)).sqrt() as f32;
+    r.min_width + (widest - r.min_width) * share.clamp(0.0, 1.0)
 }
 
 /// The head of the longest chain of reaches above `root` by drainage area (the main stem).

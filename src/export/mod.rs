@@ -7,6 +7,8 @@ use image::{ImageBuffer, Luma, Rgb, RgbImage};
 use rayon::prelude::*;
 use serde_json::json;
 
+pub mod drainage;
+
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},
     heights::FaceLattice,
@@ -240,25 +242,34 @@ pub fn draw_rivers(
             } else {
                 Rgb([60, 160, 240])
             };
-            for pair in line.points.windows(2) {
-                let (a, b) = (cross_pixel(pair[0], size), cross_pixel(pair[1], size));
-                // Skip segments that jump across the cross's gaps.
-                if (a.0 - b.0).abs() + (a.1 - b.1).abs() > size as f64 / 4.0 {
-                    continue;
-                }
-                let steps = ((a.0 - b.0).abs().max((a.1 - b.1).abs()).ceil() as u32).max(1);
-                for k in 0..=steps {
-                    let f = k as f64 / steps as f64;
-                    let (x, y) = (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f);
-                    if x >= 0.0
-                        && y >= 0.0
-                        && (x as u32) < image.width()
-                        && (y as u32) < image.height()
-                    {
-                        image.put_pixel(x as u32, y as u32, colour);
-                    }
-                }
-            }
+            draw_polyline(image, &line.points, size, colour);
         }
+    }
+}
+
+/// Draws a polyline of unit-sphere points onto a [`preview`] of `size` pixels per face.
+pub fn draw_polyline(image: &mut RgbImage, points: &[glam::DVec3], size: u32, colour: Rgb<u8>) {
+    for pair in points.windows(2) {
+        let (a, b) = (cross_pixel(pair[0], size), cross_pixel(pair[1], size));
+        // Skip segments that jump across the cross's gaps.
+        if (a.0 - b.0).abs() + (a.1 - b.1).abs() > size as f64 / 4.0 {
+            continue;
+        }
+        let steps = ((a.0 - b.0).abs().max((a.1 - b.1).abs()).ceil() as u32).max(1);
+        for k in 0..=steps {
+            let f = k as f64 / steps as f64;
+            put(
+                image,
+                (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f),
+                colour,
+            );
+        }
+    }
+}
+
+/// Sets the pixel at (x, y) if it is inside the image.
+fn put(image: &mut RgbImage, (x, y): (f64, f64), colour: Rgb<u8>) {
+    if x >= 0.0 && y >= 0.0 && (x as u32) < image.width() && (y as u32) < image.height() {
+        image.put_pixel(x as u32, y as u32, colour);
     }
 }
