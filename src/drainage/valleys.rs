@@ -9,10 +9,10 @@ const NARROWEST: f64 = 1.5;
 /// Half-width of the largest river's valley, in base lattice cells.
 const WIDEST: f64 = 4.0;
 
-/// The heights with valleys carved: a river node sits at its bed (the filled height, which never rises
-/// downstream); a node within a valley's half-width `w` at distance `d` of its nearest river node keeps its height
-/// above that bed scaled by `(d / w)^2`, never raised.
-/// Sea and lake nodes keep their heights.
+/// The heights with valleys carved. A river node sits at its bed: its filled height, lowered to the lowest of its
+/// neighbours (D8 lets a river run along a side slope, whose lower side would otherwise stand below the water),
+/// and never rising downstream. A node within a valley's half-width `w` at distance `d` of its nearest river node
+/// keeps its height above that bed scaled by `(d / w)^2`, never raised. Sea and lake nodes keep their heights.
 pub fn carve(
     grid: &SphereGrid,
     routing: &Routing,
@@ -36,6 +36,31 @@ pub fn carve(
         let share = (routing.area[k as usize] / largest).sqrt();
         cell * (NARROWEST + (WIDEST - NARROWEST) * share)
     };
+    let mut bed: Vec<f64> = routing.filled.clone();
+    for &k in &river_nodes {
+        // A neighbour under the sea or a lake counts at the water's surface: a river beside the coast comes
+        // down to the sea level.
+        let lowest = grid
+            .neighbours(k)
+            .iter()
+            .map(|&j| match network.lake_of[j as usize] {
+                Some(lake) => network.lakes[lake as usize].level,
+                None => heights[j as usize].max(sea_level),
+            })
+            .fold(f64::INFINITY, f64::min);
+        bed[k as usize] = bed[k as usize].min(lowest);
+    }
+    let is_river = {
+        let mut is = vec![false; grid.len()];
+        river_nodes.iter().for_each(|&k| is[k as usize] = true);
+        is
+    };
+    for &k in &routing.upstream_first {
+        let r = routing.receiver[k as usize];
+        if is_river[k as usize] && r != super::routing::NONE && is_river[r as usize] {
+            bed[r as usize] = bed[r as usize].min(bed[k as usize]);
+        }
+    }
     let (distance, nearest) = grid.nearest(&river_nodes, WIDEST * cell);
     let mut out = heights.to_vec();
     for k in 0..grid.len() {
@@ -43,7 +68,7 @@ pub fn carve(
         if source == u32::MAX || !dry(k) {
             continue;
         }
-        let bed = routing.filled[source as usize];
+        let bed = bed[source as usize];
         if source == k as u32 {
             out[k] = bed;
             continue;

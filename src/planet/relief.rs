@@ -14,14 +14,17 @@ const STREAM_HILLS: u64 = 0x524c_0002;
 /// Angle over which land rises to its full height from the coast (radians; about 380 km on Earth).
 const RISE_ANGLE: f64 = 0.25;
 /// Angle over which the sea floor falls to the ocean depth from the coast.
-const SHELF_ANGLE: f64 = 0.03;
+const SHELF_ANGLE: f64 = 0.1;
+/// Angle over which the shore rises from the sea level to `continent-height`.
+const SHORE_ANGLE: f64 = 0.08;
 /// Ranges per radian: the frequency of the ridged noise's first octave.
 const RANGE_FREQUENCY: f64 = 5.0;
 const HILL_FREQUENCY: f64 = 24.0;
 
 /// Replaces the continents' two heights (land at `continent-height`, sea at `ocean-height`) with relief: on land
-/// `continent-height` at the coast rising to `max-mountain-height` on the crests of the ranges, at sea the shelf.
-/// Land stays land and sea stays sea.
+/// a shore rising from the sea level to `continent-height`, and inland a rise to `max-mountain-height` on the
+/// crests of the ranges; at sea a shelf falling from the sea level to `ocean-height`. Land stays land and sea
+/// stays sea.
 pub fn raise(lattice: &mut FaceLattice, grid: &SphereGrid, planet: &PlanetConfig, seed: u64) {
     let heights = grid.values(lattice);
     let sea_level = planet.sea_level_height as f64;
@@ -52,10 +55,12 @@ pub fn raise(lattice: &mut FaceLattice, grid: &SphereGrid, planet: &PlanetConfig
                 let ranges = noise::ridged(ranges_seed, d, RANGE_FREQUENCY, 5);
                 let hills = noise::fbm(hills_seed, d, HILL_FREQUENCY, 3);
                 let relief = 0.15 + 0.85 * ranges * ranges + 0.08 * hills;
-                (low + (high - low) * rise * relief).max(sea_level + 0.05 * (low - sea_level))
+                let shore = 1.0 - (-to_sea[k] / SHORE_ANGLE).exp();
+                let h = sea_level + (low - sea_level) * shore + (high - low) * rise * relief;
+                h.max(sea_level + 0.01 * (low - sea_level))
             } else {
-                let shelf = (-to_land[k] / SHELF_ANGLE).exp();
-                ocean + (sea_level - ocean) * 0.9 * shelf
+                let shelf = 1.0 - (-to_land[k] / SHELF_ANGLE).exp();
+                sea_level - (sea_level - ocean) * shelf
             }
         })
         .collect();
