@@ -159,3 +159,43 @@ fn the_thesis_rivers_fail_the_bank_check() {
     );
     assert!(f.worst_excess > BANK_TOLERANCE);
 }
+
+/// Lake water: at the lake's level, except where a river flows in and the kernel's average over the influence
+/// distance lifts the water towards the river's (0.18 at most on config/drainage.xml seed 1).
+const LAKE_TOLERANCE: f64 = 0.2;
+
+#[test]
+fn lakes_are_drawn_as_water_at_their_level() {
+    let world = world(RiverModel::Drainage);
+    let drainage = world.planet.drainage.as_ref().unwrap();
+    assert!(!drainage.lakes.is_empty());
+    let n = world.config.rendering.vertices;
+    let params = KernelParams::from_config(&world.config);
+    let mut deviations = Vec::new();
+    for lake in &drainage.lakes {
+        for &p in &lake.points {
+            let patch = PatchId::containing(p, LEVEL);
+            let frame = PatchFrame::new(patch, world.planet.radius, n);
+            let samples = patch_samples(&world.network, &frame).samples;
+            let at = frame.to_patch(p);
+            let t = calculate_height([at.x as f32, at.y as f32], &samples, &params);
+            // The water stands over the drawn ground.
+            assert!(t.water_height >= t.terrain_height, "{t:?}");
+            deviations.push((t.water_height as f64 - lake.level as f64).abs());
+        }
+    }
+    deviations.sort_by(f64::total_cmp);
+    let (median, worst) = (
+        deviations[deviations.len() / 2],
+        deviations[deviations.len() - 1],
+    );
+    println!(
+        "{} lake points: water {median:.4} from the level at the median, {worst:.4} at most",
+        deviations.len()
+    );
+    assert!(
+        median <= 1e-3,
+        "lake water {median} off its level at the median"
+    );
+    assert!(worst <= LAKE_TOLERANCE, "lake water {worst} off its level");
+}

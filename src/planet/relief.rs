@@ -4,6 +4,7 @@
 //! smooth heights cross the sea level instead of on the base lattice's cell edges.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::{heights::FaceLattice, noise};
 use crate::{config::PlanetConfig, drainage::grid::SphereGrid, rng};
@@ -48,6 +49,7 @@ pub fn raise(lattice: &mut FaceLattice, grid: &SphereGrid, planet: &PlanetConfig
     let ranges_seed = rng::hash(seed, &[STREAM_RANGES]);
     let hills_seed = rng::hash(seed, &[STREAM_HILLS]);
     let raised: Vec<f64> = (0..grid.len())
+        .into_par_iter()
         .map(|k| {
             let d: DVec3 = grid.directions[k];
             if land[k] {

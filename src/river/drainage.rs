@@ -6,10 +6,14 @@
 use glam::{DVec2, DVec3};
 
 use super::{
-    network::{enclose, RiverFrame, RiverSystem, Segment, SubdivisionParams},
+    network::{enclose, RiverFrame, RiverSystem, Segment, SubdivisionParams, MAX_DEPTH},
     spline::Hermite,
 };
-use crate::{config::Config, drainage::Drainage, rng};
+use crate::{
+    config::Config,
+    drainage::{Drainage, LakeShape},
+    rng,
+};
 
 /// Largest angle between a system's anchor (where it ends) and any of its points; reaches beyond it start a
 /// system of their own, so that the gnomonic frame stays within a few percent of true distances.
@@ -60,7 +64,7 @@ pub fn systems(
     let mut roots: Vec<usize> = (0..reaches.len()).filter(|&k| anchor[k] == k).collect();
     let mouth_area = |k: usize| reaches[k].areas.last().copied().unwrap_or(0.0);
     roots.sort_by(|a, b| mouth_area(*b).total_cmp(&mouth_area(*a)));
-    roots
+    let mut systems: Vec<RiverSystem> = roots
         .iter()
         .enumerate()
         .map(|(id, &root)| {
@@ -114,7 +118,59 @@ pub fn systems(
                 (source, mouth),
             )
         })
-        .collect()
+        .collect();
+    for lake in &drainage.lakes {
+        let id = systems.len() as u32;
+        systems.push(lake_system(lake, id, radius, config, params));
+    }
+    systems
+}
+
+/// A lake as a river system the kernel draws as water at the lake's level: one short straight piece through each
+/// of its lattice points, a base cell long and one and a half cells wide, so the pieces' basins cover the lake.
+/// The pieces are at the deepest subdivision already (no meanders, no tributaries), and their bed lies the basin
+/// depth minus the water offset below the level, which puts the kernel's water height (bed + basin depth - water
+/// offset, Procedure 5) at the level.
+fn lake_system(
+    lake: &LakeShape,
+    id: u32,
+    radius: f64,
+    config: &Config,
+    params: &SubdivisionParams,
+) -> RiverSystem {
+    let centre = lake.points.iter().copied().sum::<DVec3>().normalize();
+    let frame = RiverFrame::new(centre, centre.any_orthonormal_vector() + centre, radius);
+    // The distance between neighbouring lattice points of the lake: its area over its points.
+    let cell = (lake.area / lake.points.len().max(1) as f64).sqrt();
+    let r = &config.river;
+    let bed = lake.level - r.basin_depth + r.basin_water_offset;
+    let width = (1.5 * cell) as f32;
+    let branch = rng::hash(params.seed, &[0x6c61_6b65, id as u64]);
+    let half = DVec2::new(0.5 * cell, 0.0);
+    let segments = lake
+        .points
+        .iter()
+        .enumerate()
+        .filter_map(|(k, p)| {
+            let at = frame.to_plane(*p)?;
+            Some(Segment {
+                curve: Hermite {
+                    p0: at - half,
+                    d0: half * 2.0,
+                    p1: at + half,
+                    d1: half * 2.0,
+                },
+                heights: (bed, bed),
+                widths: (width, width),
+                key: rng::hash(branch, &[k as u64]),
+                depth: MAX_DEPTH,
+                generation: 0,
+                branch,
+                parent_branch: None,
+            })
+        })
+        .collect();
+    enclose(config, params, (id, 0), frame, segments, (centre, centre))
 }
 
 /// Hydraulic geometry: a river's full width grows with the square root of its discharge, taken as proportional
