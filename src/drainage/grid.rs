@@ -21,9 +21,10 @@ pub struct SphereGrid {
     pub areas: Vec<f64>,
     /// Node of each lattice point, indexed as [`FaceLattice::index`].
     node_of: Vec<u32>,
-    /// Neighbours of node k: `neighbours[offsets[k]..offsets[k + 1]]`, without repeats.
+    /// Neighbours of node k: `neighbours[offsets[k]..offsets[k + 1]]`, without repeats, and the angle to each.
     offsets: Vec<u32>,
     neighbours: Vec<u32>,
+    angles: Vec<f64>,
 }
 
 impl SphereGrid {
@@ -72,6 +73,16 @@ impl SphereGrid {
             neighbours.extend(list);
             offsets.push(neighbours.len() as u32);
         }
+        let angles = (0..directions.len())
+            .flat_map(|k| {
+                let range = offsets[k] as usize..offsets[k + 1] as usize;
+                let here = directions[k];
+                let (neighbours, directions) = (&neighbours, &directions);
+                range.map(move |e| {
+                    crate::planet::cube::angle(here, directions[neighbours[e] as usize])
+                })
+            })
+            .collect();
         Self {
             cells: c,
             directions,
@@ -79,6 +90,7 @@ impl SphereGrid {
             node_of,
             offsets,
             neighbours,
+            angles,
         }
     }
 
@@ -98,6 +110,16 @@ impl SphereGrid {
     pub fn neighbours(&self, node: u32) -> &[u32] {
         let k = node as usize;
         &self.neighbours[self.offsets[k] as usize..self.offsets[k + 1] as usize]
+    }
+
+    /// The neighbours of `node` with the angle to each (radians on the unit sphere).
+    pub fn steps(&self, node: u32) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let k = node as usize;
+        let range = self.offsets[k] as usize..self.offsets[k + 1] as usize;
+        self.neighbours[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.angles[range].iter().copied())
     }
 
     /// The angle between two nodes (radians on the unit sphere).
@@ -129,8 +151,8 @@ impl SphereGrid {
             if d > distance[node as usize] {
                 continue;
             }
-            for &next in self.neighbours(node) {
-                let nd = d + self.angle(node, next);
+            for (next, step) in self.steps(node) {
+                let nd = d + step;
                 if nd < distance[next as usize] && nd <= limit {
                     distance[next as usize] = nd;
                     from[next as usize] = from[node as usize];

@@ -87,10 +87,10 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
 fn steepest_lower(grid: &SphereGrid, filled: &[f64], node: u32, except: &[u32]) -> u32 {
     let h = filled[node as usize];
     let mut best = (0.0, NONE);
-    for &next in grid.neighbours(node) {
+    for (next, angle) in grid.steps(node) {
         let drop = h - filled[next as usize];
         if drop > 0.0 && !except.contains(&next) {
-            let slope = drop / grid.angle(node, next);
+            let slope = drop / angle;
             if slope > best.0 {
                 best = (slope, next);
             }

@@ -203,7 +203,12 @@ impl Planet {
         let total: f64 = weights.iter().sum();
         let mut attempt = 0;
         let drainage_model = config.river.model == RiverModel::Drainage;
-        let grid = drainage_model.then(|| SphereGrid::new(&FaceLattice::new(base_cells, 0.0)));
+        let grid = drainage_model.then(|| {
+            let t = Instant::now();
+            let grid = SphereGrid::new(&FaceLattice::new(base_cells, 0.0));
+            time("drainage grid", t);
+            grid
+        });
         loop {
             let t = Instant::now();
             let (land, weight) = match &image_land {
