@@ -324,7 +324,9 @@ fn main() -> ExitCode {
                 descents: &descent,
                 commands: &commands,
             };
-            match bench::report::results_markdown(&inputs).map(|md| std::fs::write(&out, md)) {
+            match bench::report::results_markdown(&inputs)
+                .map(|md| riverplanet::export::files::write_bytes(&out, md.as_bytes()))
+            {
                 Ok(Ok(())) => ExitCode::SUCCESS,
                 Ok(Err(e)) => {
                     eprintln!("error: cannot write {}: {e}", out.display());
@@ -426,6 +428,11 @@ fn info(options: &ContextOptions, json: bool) -> ExitCode {
     }
 }
 
+/// Checks an output path before any work (export::files::check_output).
+fn check_output(argument: &str, path: &std::path::Path, png_only: bool) -> anyhow::Result<()> {
+    riverplanet::export::files::check_output(argument, path, png_only).map_err(anyhow::Error::msg)
+}
+
 fn load_config(path: &std::path::Path) -> anyhow::Result<Config> {
     let config = Config::load(path)?;
     log::info!("resolved configuration: {config:?}");
@@ -433,8 +440,10 @@ fn load_config(path: &std::path::Path) -> anyhow::Result<Config> {
 }
 
 fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
-    std::fs::write(path, serde_json::to_string_pretty(value)?)
-        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+    Ok(riverplanet::export::files::write_bytes(
+        path,
+        serde_json::to_string_pretty(value)?.as_bytes(),
+    )?)
 }
 
 fn check_validation(ctx: &Context) -> anyhow::Result<()> {
@@ -460,6 +469,9 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             json,
         } => {
             let config = load_config(&config)?;
+            if let Some(path) = &json {
+                check_output("--json", path, false)?;
+            }
             let world = riverplanet::world::World::build(&config, seed)?;
             let ctx = Context::new(options)?;
             let tuning = KernelTuning {
@@ -535,6 +547,11 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
         } => {
             use std::io::IsTerminal;
             let config = load_config(&config)?;
+            for (argument, path) in [("--json", Some(&json)), ("--csv", csv.as_ref())] {
+                if let Some(path) = path {
+                    check_output(argument, path, false)?;
+                }
+            }
             for dir in hole_images.iter().chain(&frame_images) {
                 std::fs::create_dir_all(dir)
                     .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
@@ -621,8 +638,10 @@ fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()>
             println!("  frame ms by water mode: {:?}", s.water_mode_frame_ms);
             check_validation(&ctx)?;
             if let Some(path) = csv {
-                std::fs::write(&path, bench::flight::to_csv(&report))
-                    .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+                riverplanet::export::files::write_bytes(
+                    &path,
+                    bench::flight::to_csv(&report).as_bytes(),
+                )?;
             }
             let mut report = report;
             if summary_only {
@@ -715,23 +734,19 @@ fn generate(
             }
             None => riverplanet::export::draw_rivers(&mut image, &network, geojson_depth, 256),
         }
-        image
-            .save(&path)
-            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+        riverplanet::export::files::save_image(&image, &path)?;
     }
     if equirect {
         let path = out.join("continents.png");
-        riverplanet::export::equirectangular_land(&planet, 1024)
-            .save(&path)
-            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+        let land = riverplanet::export::equirectangular_land(&planet, 1024);
+        riverplanet::export::files::save_image(&land, &path)?;
     }
     let path = out.join("rivers.geojson");
     let geojson = match &planet.drainage {
         Some(drainage) => riverplanet::export::drainage::drainage_geojson(drainage, &config),
         None => riverplanet::export::rivers_geojson(&network, geojson_depth),
     };
-    std::fs::write(&path, serde_json::to_string(&geojson)?)
-        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    riverplanet::export::files::write_bytes(&path, serde_json::to_string(&geojson)?.as_bytes())?;
     let mut stats = planet.stats.clone();
     stats.timings_ms.insert("rivers".to_string(), river_ms);
     stats
@@ -755,8 +770,10 @@ fn generate(
         value["river_systems"] = serde_json::json!(rivers);
     }
     let path = out.join("stats.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&value)?)
-        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    riverplanet::export::files::write_bytes(
+        &path,
+        serde_json::to_string_pretty(&value)?.as_bytes(),
+    )?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
@@ -788,6 +805,7 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 
 fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     let config = load_config(&args.config)?;
+    check_output("--out", &args.out, true)?;
     let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
     if args.preset.is_none() && args.eye.length() <= config.planet.radius as f64 * 0.5 {
         anyhow::bail!(
@@ -846,9 +864,7 @@ fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
         args.max_frames,
     )?;
     let image = target.read(&ctx)?;
-    image
-        .save(&args.out)
-        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", args.out.display()))?;
+    riverplanet::export::files::save_image(&image, &args.out)?;
     println!(
         "{}: {w}x{h}, {frames} frames to stream the patches; last frame: {} visible patches, {} resident, \
          deepest level {}",
@@ -876,6 +892,9 @@ fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
 
 fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
     let config = load_config(&args.config)?;
+    if let Some(path) = &args.screenshot {
+        check_output("--screenshot", path, true)?;
+    }
     let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.eye {

@@ -270,3 +270,71 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
         .count();
     assert!(dark > 50, "{dark} pixels of order 4 or 5 rivers");
 }
+
+#[test]
+fn an_adapter_that_matches_no_device_is_named_not_a_crash() {
+    let run = riverplanet()
+        .args([
+            "render",
+            "--adapter",
+            "no-such-device",
+            "--size",
+            "32x18",
+            "--out",
+        ])
+        .arg(temp_dir("adapter").join("x.png"))
+        .output()
+        .unwrap();
+    // A signal (the segfault this used to be) has no exit code.
+    assert_eq!(run.status.code(), Some(1), "{run:?}");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("--adapter") && stderr.contains("no-such-device"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn bad_output_paths_are_refused_before_any_work_and_nothing_is_overwritten() {
+    let dir = temp_dir("outputs");
+    let keep = dir.join("keep.jpg");
+    std::fs::write(&keep, b"keep").unwrap();
+    for (out, culprit) in [
+        (dir.join("missing/x.png"), "does not exist"),
+        (keep.clone(), "must end in .png"),
+        (dir.clone(), "is a folder"),
+    ] {
+        let started = std::time::Instant::now();
+        let run = riverplanet()
+            .args(["render", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains("--out") && stderr.contains(culprit),
+            "{stderr}"
+        );
+        // Refused before the planet is generated or a device opened.
+        assert!(started.elapsed().as_secs_f64() < 5.0);
+    }
+    assert_eq!(std::fs::read(&keep).unwrap(), b"keep");
+    let run = riverplanet()
+        .args(["render", "--size", "32x18", "--out"])
+        .arg(dir.join("ok.png"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // Written through a temporary file that was renamed: nothing else is left in the folder.
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["keep.jpg", "ok.png"]);
+}

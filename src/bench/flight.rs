@@ -227,9 +227,8 @@ fn fly(
                 let holes = hole_pixels(&image, &camera, inner).0;
                 let save = |dir: &std::path::Path, name: String| {
                     let path = dir.join(name);
-                    image.save(&path).map_err(|e| {
-                        GpuError::Invalid(format!("cannot write {}: {e}", path.display()))
-                    })
+                    crate::export::files::save_image(&image, &path)
+                        .map_err(|e| GpuError::Invalid(e.to_string()))
                 };
                 if let (true, Some(dir)) = (holes > 0, &options.hole_images) {
                     save(dir, format!("holes-{frame:03}.png"))?;

@@ -112,10 +112,8 @@ pub fn line_chart(
     draw!(SVGBackend::new(&svg, (w, h)));
     let mut pixels = vec![0u8; (w * h * 3) as usize];
     draw!(BitMapBackend::with_buffer(&mut pixels, (w, h)));
-    image::RgbImage::from_raw(w, h, pixels)
-        .ok_or_else(|| draw_err(&"buffer size"))?
-        .save(base.with_extension("png"))
-        .map_err(|e| draw_err(&e))
+    let image = image::RgbImage::from_raw(w, h, pixels).ok_or_else(|| draw_err(&"buffer size"))?;
+    crate::export::files::save_image(&image, &base.with_extension("png")).map_err(|e| draw_err(&e))
 }
 
 fn read(path: &Path) -> Result<Value, PlotError> {

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use serde_json::json;
 
 pub mod drainage;
+pub mod files;
 
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},
@@ -51,15 +52,15 @@ pub fn write_faces(lattice: &FaceLattice, level: u32, dir: &Path) -> Result<(), 
                 .clamp(0.0, 65535.0) as u16])
         });
         let path = faces_dir.join(format!("face{face}.png"));
-        let file = fs::File::create(&path).map_err(|e| write_err(&path, e))?;
-        let encoder = image::codecs::png::PngEncoder::new_with_quality(
-            std::io::BufWriter::new(file),
-            image::codecs::png::CompressionType::Fast,
-            image::codecs::png::FilterType::Sub,
-        );
-        image
-            .write_with_encoder(encoder)
-            .map_err(|e| write_err(&path, e))
+        files::write_atomically(&path, |temporary| {
+            let file = fs::File::create(temporary).map_err(|e| e.to_string())?;
+            let encoder = image::codecs::png::PngEncoder::new_with_quality(
+                std::io::BufWriter::new(file),
+                image::codecs::png::CompressionType::Fast,
+                image::codecs::png::FilterType::Sub,
+            );
+            image.write_with_encoder(encoder).map_err(|e| e.to_string())
+        })
     })?;
     let step = 2.0 / lattice.cells as f64;
     let layout: Vec<_> = (0..FACES)
@@ -82,7 +83,7 @@ pub fn write_faces(lattice: &FaceLattice, level: u32, dir: &Path) -> Result<(), 
         "faces": layout,
     }))
     .map_err(|e| write_err(&path, e))?;
-    fs::write(&path, text).map_err(|e| write_err(&path, e))
+    files::write_bytes(&path, text.as_bytes())
 }
 
 /// Terrain colour for a height (sea by depth, then sand, grass, rock, snow).

@@ -280,11 +280,15 @@ impl Context {
     pub fn new(options: &ContextOptions) -> Result<Self, GpuError> {
         let entry = load_entry()?;
         let (instance, validation_enabled) = create_instance(&entry, options)?;
-        match Self::with_instance(entry, instance.clone(), validation_enabled, options) {
+        // The context gets its own handle to the loader: this one keeps libvulkan loaded until the instance is
+        // destroyed on the error path (dropping the only Entry first unloads the library under the call, which
+        // crashed every command on a device that was present but unusable).
+        match Self::with_instance(entry.clone(), instance.clone(), validation_enabled, options) {
             Ok(ctx) => Ok(ctx),
             Err(e) => {
-                // SAFETY: with_instance destroyed everything it created before failing.
+                // SAFETY: with_instance destroyed everything it created before failing; `entry` is still loaded.
                 unsafe { instance.destroy_instance(None) };
+                drop(entry);
                 Err(e)
             }
         }

@@ -377,7 +377,7 @@ impl App<'_> {
         })();
         target.destroy(self.ctx);
         let image = result?;
-        image.save(path).map_err(|e| ViewerError::Screenshot {
+        crate::export::files::save_image(&image, path).map_err(|e| ViewerError::Screenshot {
             path: path.display().to_string(),
             message: e.to_string(),
         })?;
