@@ -319,7 +319,13 @@ impl Reader<'_> {
     ) -> Result<f32, ConfigError> {
         let Some(text) = raw else { return Ok(default) };
         match clean(text).parse::<f64>() {
-            Ok(x) if range.contains(x) => Ok(x as f32),
+            // The value must hold as an f32 too: 1e39 would become infinity and 1e-50 zero.
+            Ok(x) if range.contains(x) && range.contains(x as f32 as f64) => Ok(x as f32),
+            Ok(x) if range.contains(x) => Err(self.error(
+                element,
+                text,
+                format!("{range}, within single precision (about 1.2e-38 to 3.4e38 in size)"),
+            )),
             _ => Err(self.error(element, text, range)),
         }
     }

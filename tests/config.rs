@@ -154,3 +154,39 @@ fn seed_accepts_minus_one_and_rejects_below() {
     let c = Config::parse(&with("planet-attributes", "master-seed", "42"), "t").unwrap();
     assert_eq!(c.resolve_seed(), 42);
 }
+
+#[test]
+fn numbers_beyond_single_precision_are_refused_by_element() {
+    for (element, value) in [
+        ("radius", "1e39"),
+        ("radius", "1e-50"),
+        ("influence-distance", "4e38"),
+    ] {
+        let section = if element == "radius" {
+            "planet-attributes"
+        } else {
+            "river-attributes"
+        };
+        let message = error_of(&with(section, element, value));
+        assert!(
+            message.contains(element) && message.contains(value),
+            "{message}"
+        );
+        assert!(message.contains("single precision"), "{message}");
+    }
+}
+
+#[test]
+fn the_river_model_is_named_or_refused() {
+    let c = Config::parse(
+        &with("river-attributes", "river-model", "drainage"),
+        "t.xml",
+    )
+    .unwrap();
+    assert_eq!(c.river.model, riverplanet::config::RiverModel::Drainage);
+    let message = error_of(&with("river-attributes", "river-model", "rain"));
+    assert!(
+        message.contains("river-model") && message.contains("thesis, drainage"),
+        "{message}"
+    );
+}
