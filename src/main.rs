@@ -110,13 +110,13 @@ struct RenderArgs {
     #[arg(long)]
     seed: Option<u32>,
     /// Camera position, world units with the planet centre at the origin.
-    #[arg(long, value_parser = parse_vec3, default_value = "0,1200,3400")]
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1200,3400", allow_hyphen_values = true)]
     eye: glam::DVec3,
-    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0")]
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
     look_at: glam::DVec3,
     /// Place the camera from the planet's own features instead of --eye/--look-at: `orbit` (the first river's
     /// side of the planet), `mountains` (above the first river's source), `river` (close above the first river).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, conflicts_with_all = ["eye", "look_at"])]
     preset: Option<riverplanet::render::presets::Preset>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 45.0)]
@@ -133,7 +133,7 @@ struct RenderArgs {
     /// selection with morphing.
     #[arg(long)]
     no_morphing: bool,
-    #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06")]
+    #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
     clear_color: glam::DVec3,
     /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
     #[arg(long, default_value_t = 200)]
@@ -151,9 +151,9 @@ struct ViewArgs {
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
     size: [u32; 2],
     /// Start position (default: the orbit preset).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     eye: Option<glam::DVec3>,
-    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0")]
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
     look_at: glam::DVec3,
     #[arg(long, value_enum, default_value = "auto")]
     water: WaterMode,

@@ -338,3 +338,39 @@ fn bad_output_paths_are_refused_before_any_work_and_nothing_is_overwritten() {
     names.sort();
     assert_eq!(names, ["keep.jpg", "ok.png"]);
 }
+
+#[test]
+fn cameras_take_negative_coordinates_and_a_preset_refuses_an_eye() {
+    let dir = temp_dir("camera");
+    let run = riverplanet()
+        .args([
+            "render",
+            "--eye",
+            "-610,430,890",
+            "--look-at",
+            "-1,0,0",
+            "--size",
+            "32x18",
+            "--out",
+        ])
+        .arg(dir.join("negative.png"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let run = riverplanet()
+        .args(["render", "--preset", "orbit", "--eye", "1,2,3000", "--out"])
+        .arg(dir.join("preset.png"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--preset") && stderr.contains("--eye"),
+        "{stderr}"
+    );
+    assert!(!dir.join("preset.png").exists());
+}
