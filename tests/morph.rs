@@ -13,8 +13,8 @@ use riverplanet::{
     planet::cube::PatchId,
     render::{
         presets::{self, Preset},
-        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
-        Renderer, VertexCapture,
+        target::Offscreen,
+        VertexCapture,
     },
     runtime::camera::Camera,
     world::World,
@@ -111,15 +111,7 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
     let ground = r + world.planet.height_at(up).max(world.planet.sea_level) as f64;
     let size = [96, 54];
     let offscreen = Offscreen::new(ctx, size[0], size[1]).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &world.config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
+    let mut renderer = common::renderer(ctx, world);
     renderer.morphing = morphing;
     let mut layout = vk::ImageLayout::UNDEFINED;
     let mut previous: Option<VertexCapture> = None;

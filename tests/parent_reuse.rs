@@ -17,8 +17,8 @@ use riverplanet::{
     planet::cube::PatchId,
     render::{
         presets::{self, Preset},
-        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
-        Renderer, VertexCapture,
+        target::Offscreen,
+        VertexCapture,
     },
     river::samples::{patch_samples, PatchFrame, PatchSamples},
     runtime::camera::Camera,
@@ -193,15 +193,7 @@ fn ground_vertices(parent_reuse: bool) -> Option<(VertexCapture, usize)> {
     let camera = Camera::look_at(eye, look_at, 60.0, 16.0 / 9.0, 0.1);
     let offscreen = Offscreen::new(ctx, 64, 36).unwrap();
     let target = offscreen.target([0.0, 0.0, 0.0, 1.0]);
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &world.config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
+    let mut renderer = common::renderer(ctx, &world);
     renderer.parent_reuse = parent_reuse;
     let mut layout = vk::ImageLayout::UNDEFINED;
     let mut from_parent = 0;

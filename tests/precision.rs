@@ -13,7 +13,7 @@ use riverplanet::{
     planet::cube::PatchId,
     render::{
         presets::{self, Preset},
-        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        target::Offscreen,
         Renderer, VertexCapture,
     },
     runtime::camera::Camera,
@@ -58,15 +58,7 @@ fn two_metres_above_an_earth_sized_river_vertices_are_exact_to_a_millimetre_and_
     let n = config.rendering.vertices;
     let (eye, look_at) = presets::camera(Preset::Ground, &world).unwrap();
     let offscreen = Offscreen::new(ctx, 64, 36).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &world.config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
+    let mut renderer = common::renderer(ctx, &world);
     let target = offscreen.target([0.0, 0.0, 0.0, 1.0]);
     let mut layout = vk::ImageLayout::UNDEFINED;
     // `frames` frames at most, until every visible patch has its data.

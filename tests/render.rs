@@ -11,7 +11,7 @@ use riverplanet::{
     gpu::{vk, Context},
     render::{
         presets::{self, Preset},
-        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        target::Offscreen,
         Renderer, WaterMode,
     },
     runtime::camera::Camera,
@@ -176,15 +176,7 @@ fn render_with(
 ) -> image::RgbaImage {
     let world = world();
     let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &world.config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
+    let mut renderer = common::renderer(ctx, world);
     setup(&mut renderer);
     let mut layout = vk::ImageLayout::UNDEFINED;
     renderer

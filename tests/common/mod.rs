@@ -6,7 +6,14 @@
 
 use std::sync::OnceLock;
 
-use riverplanet::gpu::{Context, ContextOptions};
+use riverplanet::{
+    gpu::{Context, ContextOptions},
+    render::{
+        target::{COLOR_FORMAT, DEPTH_FORMAT},
+        Renderer,
+    },
+    world::World,
+};
 
 static CONTEXT: OnceLock<Result<Context, String>> = OnceLock::new();
 
@@ -45,4 +52,17 @@ pub fn assert_no_validation_errors(ctx: &Context) {
         "validation errors:\n{}",
         errors.join("\n")
     );
+}
+
+/// A renderer of `world` for the offscreen target's formats.
+pub fn renderer<'a>(ctx: &'a Context, world: &'a World) -> Renderer<'a> {
+    Renderer::new(
+        ctx,
+        &world.planet,
+        &world.network,
+        &world.config,
+        COLOR_FORMAT,
+        DEPTH_FORMAT,
+    )
+    .unwrap()
 }
