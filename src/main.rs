@@ -136,7 +136,7 @@ struct RenderArgs {
     #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
     clear_color: glam::DVec3,
     /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
     max_frames: u32,
     #[arg(long)]
     out: PathBuf,
@@ -177,14 +177,14 @@ enum BenchCommand {
         #[arg(long)]
         stress: bool,
         /// Frames of the flight that produces the workload.
-        #[arg(long, default_value_t = 300)]
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
         frames: u32,
         /// Compare river data taken from the parent patch (10.2) with computing from scratch, on the patches of
         /// the descent to the ground whose parents have the rivers' final detail (use config/earth.xml).
         #[arg(long, conflicts_with = "stress")]
         parent_reuse: bool,
         /// Repetitions per variant (the median is reported).
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, value_parser = positive_count)]
         repetitions: usize,
         /// Invocations per workgroup of the simple kernel.
         #[arg(long, default_value_t = KernelTuning::default().simple_workgroup)]
@@ -224,10 +224,10 @@ enum BenchCommand {
         /// Compute every patch's river data from scratch, as the thesis (no data from the parent, 10.2).
         #[arg(long)]
         no_parent_reuse: bool,
-        #[arg(long, default_value_t = 300)]
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, value_parser = positive_number)]
         speed: f64,
         #[arg(long, value_parser = parse_size, default_value = "1280x720")]
         size: [u32; 2],
@@ -778,6 +778,22 @@ fn generate(
         bar.finish_and_clear();
     }
     Ok(())
+}
+
+/// A whole number of at least 1.
+fn positive_count(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("'{text}' is not a whole number of at least 1")),
+    }
+}
+
+/// A finite number above 0.
+fn positive_number(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("'{text}' is not a finite number above 0")),
+    }
 }
 
 fn parse_vec3(text: &str) -> Result<glam::DVec3, String> {

@@ -374,3 +374,34 @@ fn cameras_take_negative_coordinates_and_a_preset_refuses_an_eye() {
     );
     assert!(!dir.join("preset.png").exists());
 }
+
+#[test]
+fn benchmark_counts_and_speeds_must_be_positive() {
+    for (option, args) in [
+        (
+            "--frames",
+            vec!["bench", "flight", "--frames", "0", "--json", "x.json"],
+        ),
+        (
+            "--speed",
+            vec!["bench", "flight", "--speed", "nan", "--json", "x.json"],
+        ),
+        (
+            "--speed",
+            vec!["bench", "flight", "--speed", "-2", "--json", "x.json"],
+        ),
+        (
+            "--repetitions",
+            vec!["bench", "kernel", "--repetitions", "0"],
+        ),
+        (
+            "--max-frames",
+            vec!["render", "--max-frames", "0", "--out", "x.png"],
+        ),
+    ] {
+        let run = riverplanet().args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(option), "{args:?}: {stderr}");
+    }
+}
