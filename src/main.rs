@@ -227,7 +227,7 @@ enum BenchCommand {
         #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).
-        #[arg(long, default_value_t = 1.0, value_parser = positive_number)]
+        #[arg(long, default_value_t = 1.0, value_parser = positive_number, allow_hyphen_values = true)]
         speed: f64,
         #[arg(long, value_parser = parse_size, default_value = "1280x720")]
         size: [u32; 2],
