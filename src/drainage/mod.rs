@@ -29,8 +29,6 @@ pub struct ReachPath {
     pub strahler: u32,
     /// The reach this one flows into (an index into [`Drainage::reaches`]); `None` at a mouth.
     pub downstream: Option<usize>,
-    /// Whether the reach ends in a lake rather than the sea or another reach.
-    pub into_lake: bool,
 }
 
 /// A lake: the directions of its nodes and its water level.
@@ -78,15 +76,14 @@ pub fn drain(
     let carved = valleys::carve(grid, &routing, &network, &heights, sea_level);
     grid.write(&carved, lattice);
     let r2 = radius * radius;
+    let directions = |nodes: &[u32]| -> Vec<DVec3> {
+        nodes.iter().map(|&k| grid.directions[k as usize]).collect()
+    };
     let reaches: Vec<ReachPath> = network
         .reaches
         .iter()
         .map(|reach| ReachPath {
-            points: reach
-                .nodes
-                .iter()
-                .map(|&k| grid.directions[k as usize])
-                .collect(),
+            points: directions(&reach.nodes),
             beds: beds(reach, &carved, &network, sea_level),
             areas: reach
                 .nodes
@@ -95,10 +92,6 @@ pub fn drain(
                 .collect(),
             strahler: reach.strahler,
             downstream: reach.downstream,
-            into_lake: reach
-                .nodes
-                .last()
-                .is_some_and(|&k| network.lake_of[k as usize].is_some()),
         })
         .collect();
     let largest_area = reaches
@@ -109,11 +102,7 @@ pub fn drain(
         .lakes
         .iter()
         .map(|lake| LakeShape {
-            points: lake
-                .nodes
-                .iter()
-                .map(|&k| grid.directions[k as usize])
-                .collect(),
+            points: directions(&lake.nodes),
             level: lake.level as f32,
             area: lake
                 .nodes
