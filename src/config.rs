@@ -133,6 +133,23 @@ pub struct Config {
     pub rendering: RenderingConfig,
 }
 
+impl Config {
+    /// The defaults of `model`: Appendix A's values (`Default`) for the thesis's model; for the drainage model the
+    /// values config/drainage.xml was tuned with (docs/rivers.md): a river where 700 square units drain, a quarter
+    /// of the diamond-square detail (the relief carries the shape), and at most four samples per vertex spacing (a
+    /// thousand rivers would give coarse patches millions of samples).
+    pub fn defaults_for(model: RiverModel) -> Self {
+        let mut d = Self::default();
+        d.river.model = model;
+        if model == RiverModel::Drainage {
+            d.planet.detail_amplitude = 2.0;
+            d.river.source_area = 700.0;
+            d.river.samples_per_vertex_spacing = 4;
+        }
+        d
+    }
+}
+
 impl Default for Config {
     /// The values of Appendix A (with `master-seed` 1 instead of -1 so the default planet is reproducible).
     fn default() -> Self {
@@ -434,7 +451,19 @@ impl Config {
             }
         })?;
         let r = Reader { path };
-        let d = Config::default();
+        // The river model comes first: the defaults of the other elements depend on it.
+        let model = r.choice(
+            "river-model",
+            &raw.river_attributes
+                .as_ref()
+                .and_then(|v| v.river_model.clone()),
+            Config::default().river.model,
+            &[
+                ("thesis", RiverModel::Thesis),
+                ("drainage", RiverModel::Drainage),
+            ],
+        )?;
+        let d = Config::defaults_for(model);
         let p = raw.planet_attributes.unwrap_or_default();
         let dp = &d.planet;
         let seed_text = p.master_seed.clone();
@@ -545,15 +574,7 @@ impl Config {
         let v = raw.river_attributes.unwrap_or_default();
         let dv = &d.river;
         let river = RiverConfig {
-            model: r.choice(
-                "river-model",
-                &v.river_model,
-                dv.model,
-                &[
-                    ("thesis", RiverModel::Thesis),
-                    ("drainage", RiverModel::Drainage),
-                ],
-            )?,
+            model,
             source_area: r.f32(
                 "source-area",
                 &v.source_area,

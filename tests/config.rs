@@ -190,3 +190,23 @@ fn the_river_model_is_named_or_refused() {
         "{message}"
     );
 }
+
+#[test]
+fn the_drainage_model_brings_its_own_defaults_and_explicit_values_still_win() {
+    let drainage = with("river-attributes", "river-model", "drainage");
+    let c = Config::parse(&drainage, "t.xml").unwrap();
+    assert_eq!(c.river.source_area, 700.0);
+    assert_eq!(c.planet.detail_amplitude, 2.0);
+    assert_eq!(c.river.samples_per_vertex_spacing, 4);
+    let explicit = drainage.replacen(
+        "<river-model>",
+        "<samples-per-vertex-spacing>0</samples-per-vertex-spacing><river-model>",
+        1,
+    );
+    let c = Config::parse(&explicit, "t.xml").unwrap();
+    assert_eq!(c.river.samples_per_vertex_spacing, 0);
+    // The thesis's model keeps Appendix A's defaults.
+    let c = Config::parse(APPENDIX_A, "t.xml").unwrap();
+    assert_eq!(c.planet.detail_amplitude, 8.0);
+    assert_eq!(c.river.samples_per_vertex_spacing, 0);
+}
