@@ -1,0 +1,210 @@
+//! `riverplanet bench kernel | flight`: runs a benchmark, prints its summary and writes its reports.
+
+use riverplanet::{
+    bench,
+    gpu::{Context, ContextOptions},
+    kernel::gpu::KernelTuning,
+};
+
+use super::BenchCommand;
+use crate::{check_output, check_validation, load_config, write_json};
+
+pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()> {
+    match what {
+        BenchCommand::Kernel {
+            config,
+            seed,
+            stress,
+            frames,
+            parent_reuse,
+            repetitions,
+            simple_workgroup,
+            tiled_block,
+            tile_size,
+            json,
+        } => {
+            let config = load_config(&config)?;
+            if let Some(path) = &json {
+                check_output("--json", path, false)?;
+            }
+            let world = riverplanet::world::World::build(&config, seed)?;
+            let ctx = Context::new(options)?;
+            let tuning = KernelTuning {
+                simple_workgroup,
+                tiled_block: tiled_block.unwrap_or(KernelTuning::default().tiled_block),
+                tile_size,
+            };
+            if parent_reuse {
+                let report = bench::reuse::reuse_bench(&ctx, &world, frames, repetitions, tuning)?;
+                print!("{}", report.summary());
+                if let Some(path) = json {
+                    write_json(&path, &report)?;
+                }
+                return Ok(());
+            }
+            let report =
+                bench::kernel::kernel_bench(&ctx, &world, stress, frames, repetitions, tuning)?;
+            let v = &report.variants;
+            println!(
+                "device {} | {} patches, {} samples, {} vertex-sample pairs ({} within reach) | rayon threads {}, \
+                 LP_NUM_THREADS {}, RAYON_NUM_THREADS {}",
+                report.device,
+                report.patches,
+                report.samples,
+                report.pairs,
+                report.relevant_pairs,
+                report.threads.rayon_threads_used,
+                report.threads.lp_num_threads.as_deref().unwrap_or("unset"),
+                report.threads.rayon_num_threads.as_deref().unwrap_or("unset"),
+            );
+            println!("  cpu single   {:>10.3} ms", v.cpu_single.kernel_ms);
+            println!("  cpu rayon    {:>10.3} ms", v.cpu_rayon.kernel_ms);
+            for (name, t) in [("gpu simple", &v.gpu_simple), ("gpu tiled", &v.gpu_tiled)] {
+                println!(
+                    "  {name:<12} {:>10.3} ms kernel, {:>10.3} ms end to end",
+                    t.kernel_ms,
+                    t.end_to_end_ms.unwrap_or(f64::NAN)
+                );
+            }
+            println!(
+                "  tiled/simple {:.3} | cpu single / gpu tiled: {:.2}x kernel, {:.2}x end to end | max |diff| {:.3e} \
+                 = {:.2e} of the height range {:?}",
+                report.ratios.tiled_over_simple,
+                report.ratios.cpu_single_over_gpu_tiled_kernel,
+                report.ratios.cpu_single_over_gpu_tiled_end_to_end,
+                report.max_abs_diff,
+                report.relative_diff,
+                report.height_range
+            );
+            check_validation(&ctx)?;
+            if let Some(path) = json {
+                write_json(&path, &report)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Flight {
+            config,
+            seed,
+            stress,
+            descent,
+            hole_images,
+            frame_images,
+            no_morphing,
+            no_parent_reuse,
+            frames,
+            speed,
+            size,
+            no_kernel_comparison,
+            no_water_comparison,
+            json,
+            summary_only,
+            csv,
+        } => {
+            use std::io::IsTerminal;
+            let config = load_config(&config)?;
+            for (argument, path) in [("--json", Some(&json)), ("--csv", csv.as_ref())] {
+                if let Some(path) = path {
+                    check_output(argument, path, false)?;
+                }
+            }
+            for dir in hole_images.iter().chain(&frame_images) {
+                std::fs::create_dir_all(dir)
+                    .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+            }
+            let world = riverplanet::world::World::build(&config, seed)?;
+            let ctx = Context::new(options)?;
+            let bar = std::io::stderr()
+                .is_terminal()
+                .then(|| indicatif::ProgressBar::new(frames as u64));
+            let options = bench::flight::FlightOptions {
+                frames,
+                stress,
+                speed,
+                size,
+                compare_kernels: !no_kernel_comparison,
+                compare_water_modes: !no_water_comparison,
+                descent,
+                hole_images,
+                frame_images,
+                morphing: !no_morphing,
+                parent_reuse: !no_parent_reuse,
+            };
+            let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
+                if let Some(bar) = &bar {
+                    bar.set_message(mode.to_string());
+                    bar.set_position(frame as u64 + 1);
+                }
+            })?;
+            if let Some(bar) = bar {
+                bar.finish_and_clear();
+            }
+            let s = &report.summary;
+            println!(
+                "{} frames at {}x{} on {}{}: {:.1} ms/frame average ({:.1} fps), median {:.1}, max {:.1}",
+                s.frames,
+                size[0],
+                size[1],
+                report.device,
+                if stress {
+                    " (stress)"
+                } else if descent {
+                    " (descent)"
+                } else {
+                    ""
+                },
+                s.average_frame_ms,
+                s.average_fps,
+                s.median_frame_ms,
+                s.max_frame_ms
+            );
+            println!(
+                "  patches: {:.1} visible, {:.2} new per frame (max {}); samples {:.0} per frame (max {})",
+                s.average_visible_patches, s.average_new_patches, s.max_new_patches, s.average_samples, s.max_samples
+            );
+            println!(
+                "  memory: max {:.1} MB ({:.1} MB patch textures, {} of {} patches resident; {:.2} MB samples)",
+                s.max_memory_bytes as f64 / 1e6,
+                s.max_patch_texture_bytes as f64 / 1e6,
+                s.max_resident_patches,
+                s.resident_patch_budget,
+                s.max_temporary_sample_bytes as f64 / 1e6
+            );
+            println!(
+                "  deepest level {}; peak memory {:.1} MB; frame ms median {:.1}, max after {} warm-up frames {:.1}; \
+                 at most {} patches made in a frame; {} hole pixels in {} checked frames",
+                s.deepest_level,
+                s.peak_memory_bytes as f64 / 1e6,
+                s.frame_ms_median,
+                bench::flight::WARMUP_FRAMES,
+                s.frame_ms_max_after_warmup,
+                s.max_generated_patches,
+                s.hole_pixels,
+                s.hole_checked_frames
+            );
+            println!("  gpu ms per frame: {:?}", s.average_gpu_ms);
+            println!("  cpu ms per frame: {:?}", s.average_cpu_ms);
+            if s.kernel_frames > 0 {
+                println!(
+                    "  kernel over {} frames, average ms: {:?}",
+                    s.kernel_frames, s.kernel_average_ms
+                );
+                println!("  kernel ratios: {:?}", s.kernel_ratios);
+            }
+            println!("  frame ms by water mode: {:?}", s.water_mode_frame_ms);
+            check_validation(&ctx)?;
+            if let Some(path) = csv {
+                riverplanet::export::files::write_bytes(
+                    &path,
+                    bench::flight::to_csv(&report).as_bytes(),
+                )?;
+            }
+            let mut report = report;
+            if summary_only {
+                report.frames.clear();
+                report.water_mode_frames.clear();
+            }
+            write_json(&json, &report)?;
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,117 @@
+//! `riverplanet generate`: the planet's face images, preview, rivers and statistics.
+
+use crate::load_config;
+
+/// The finest level `generate` writes face images at (8193 pixels per edge with 33 vertices).
+const MAX_FACE_IMAGE_LEVEL: u32 = 8;
+/// The level of `generate`'s face images without `--level` (the thesis's finest precomputed level).
+const DEFAULT_FACE_IMAGE_LEVEL: u32 = 6;
+
+pub fn generate(
+    config_path: &std::path::Path,
+    out: &std::path::Path,
+    seed: Option<u32>,
+    (preview, equirect): (bool, bool),
+    level: Option<u32>,
+) -> anyhow::Result<()> {
+    use std::io::IsTerminal;
+    let config = load_config(config_path)?;
+    let deepest = config
+        .rendering
+        .max_level_of_detail
+        .min(MAX_FACE_IMAGE_LEVEL);
+    let level = level.unwrap_or(DEFAULT_FACE_IMAGE_LEVEL.min(deepest));
+    if level > deepest {
+        anyhow::bail!(
+            "--level {level} must be in [0, {deepest}] (max-level-of-detail {} of {}; face images stop at \
+             level {MAX_FACE_IMAGE_LEVEL}, {} pixels per edge)",
+            config.rendering.max_level_of_detail,
+            config_path.display(),
+            ((config.rendering.vertices - 1) << MAX_FACE_IMAGE_LEVEL) + 1
+        );
+    }
+    let seed = seed.unwrap_or_else(|| config.resolve_seed());
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(100));
+        Some(bar)
+    } else {
+        None
+    };
+    let planet = riverplanet::planet::Planet::generate(&config, seed, |stage| {
+        if let Some(bar) = &bar {
+            bar.set_message(stage.to_string());
+        }
+    })?;
+    if let Some(bar) = &bar {
+        bar.set_message("rivers");
+    }
+    let t = std::time::Instant::now();
+    let network = riverplanet::river::network::RiverNetwork::generate(&planet, &config, seed);
+    let river_ms = t.elapsed().as_secs_f64() * 1e3;
+    let geojson_depth = 2;
+    let (rivers, tributaries) = network.count(config.river.hull_levels);
+    let t = std::time::Instant::now();
+    if let Some(bar) = &bar {
+        bar.set_message("writing");
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
+    let faces = planet.face_lattice(level);
+    let faces_ms = t.elapsed().as_secs_f64() * 1e3;
+    let t = std::time::Instant::now();
+    riverplanet::export::write_faces(&faces, level, out)?;
+    if preview {
+        let path = out.join("preview.png");
+        let mut image = riverplanet::export::preview(&planet, 256);
+        match &planet.drainage {
+            Some(drainage) => {
+                riverplanet::export::drainage::draw_drainage(&mut image, drainage, 256)
+            }
+            None => riverplanet::export::draw_rivers(&mut image, &network, geojson_depth, 256),
+        }
+        riverplanet::export::files::save_image(&image, &path)?;
+    }
+    if equirect {
+        let path = out.join("continents.png");
+        let land = riverplanet::export::equirectangular_land(&planet, 1024);
+        riverplanet::export::files::save_image(&land, &path)?;
+    }
+    let path = out.join("rivers.geojson");
+    let geojson = match &planet.drainage {
+        Some(drainage) => riverplanet::export::drainage::drainage_geojson(drainage, &config),
+        None => riverplanet::export::rivers_geojson(&network, geojson_depth),
+    };
+    riverplanet::export::files::write_bytes(&path, serde_json::to_string(&geojson)?.as_bytes())?;
+    let mut stats = planet.stats.clone();
+    stats.timings_ms.insert("rivers".to_string(), river_ms);
+    stats
+        .timings_ms
+        .insert(format!("face images level {level}"), faces_ms);
+    stats
+        .timings_ms
+        .insert("write".to_string(), t.elapsed().as_secs_f64() * 1e3);
+    let mut value = serde_json::to_value(&stats)?;
+    value["rivers"] = serde_json::json!(rivers);
+    value["tributaries"] = serde_json::json!(tributaries);
+    value["abandoned_river_sources"] = serde_json::json!(network.abandoned_sources);
+    value["rivers_geojson_lod"] = serde_json::json!(geojson_depth);
+    if let Some(drainage) = &planet.drainage {
+        // The drainage model's measures, at the top level (docs/rivers.md).
+        if let serde_json::Value::Object(measures) = serde_json::to_value(&drainage.measures)? {
+            for (key, v) in measures {
+                value[key] = v;
+            }
+        }
+        value["river_systems"] = serde_json::json!(rivers);
+    }
+    let path = out.join("stats.json");
+    riverplanet::export::files::write_bytes(
+        &path,
+        serde_json::to_string_pretty(&value)?.as_bytes(),
+    )?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    Ok(())
+}

@@ -1,0 +1,301 @@
+//! The command line: the arguments of every command (clap lives here and nowhere else in the program), and one
+//! module per group of commands.
+
+pub mod benchmarks;
+pub mod generate;
+pub mod render;
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+use riverplanet::{
+    kernel::gpu::KernelTuning,
+    render::{ViewMode, WaterMode},
+};
+
+#[derive(Parser)]
+#[command(
+    name = "riverplanet",
+    version,
+    about = "River networks on procedural planets, rendered with Vulkan"
+)]
+pub struct Cli {
+    /// Use the first Vulkan device whose name contains this text.
+    #[arg(long, global = true, env = "RIVERPLANET_ADAPTER")]
+    pub adapter: Option<String>,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Show the Vulkan instance, every device, the chosen one and each required feature; fails if none is usable.
+    Info {
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the resolved configuration of FILE (exit code 2 if it is invalid).
+    Config { file: PathBuf },
+    /// Generate the planet: per-face heightmaps, statistics and (with --preview) an unfolded picture.
+    Generate {
+        #[arg(long, default_value = "config/planet.xml")]
+        config: PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Override master-seed.
+        #[arg(long)]
+        seed: Option<u32>,
+        /// Also write DIR/preview.png, the six faces unfolded.
+        #[arg(long)]
+        preview: bool,
+        /// Also write DIR/continents.png, land and sea as an equirectangular image (input for continents-from-file).
+        #[arg(long)]
+        equirect: bool,
+        /// Level of detail of the face images (32 x 2^N + 1 pixels per edge with 33 vertices), made by the same
+        /// on-demand refinement as the renderer's patches. Default: 6, or max-level-of-detail if lower.
+        #[arg(long)]
+        level: Option<u32>,
+    },
+    /// Render one image headless (no display, no window system) and print per-pass GPU times.
+    Render(RenderArgs),
+    /// Open the interactive viewer (needs a display; see the README for keys).
+    View(ViewArgs),
+    /// Draw the figures of Chapter 9 (SVG and PNG) from `bench flight` JSON reports.
+    Plot {
+        /// Report of the normal flight.
+        #[arg(long)]
+        flight: PathBuf,
+        /// Report of the stress flight.
+        #[arg(long)]
+        stress: Option<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Write docs/results.md from the JSON reports of `bench kernel` and `bench flight` (see tools/results).
+    Report {
+        #[arg(long)]
+        kernel: PathBuf,
+        #[arg(long)]
+        kernel_stress: PathBuf,
+        #[arg(long)]
+        flight: PathBuf,
+        #[arg(long)]
+        flight_stress: PathBuf,
+        #[arg(long)]
+        long_flight: Option<PathBuf>,
+        /// The report of `bench kernel --parent-reuse`.
+        #[arg(long)]
+        kernel_reuse: Option<PathBuf>,
+        /// Reports of `bench flight --descent` (repeat the option for several).
+        #[arg(long)]
+        descent: Vec<PathBuf>,
+        /// A file with the commands that made the reports (quoted in the document).
+        #[arg(long)]
+        commands: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Measure the river kernel variants side by side in one run.
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
+}
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    #[arg(long, default_value = "config/planet.xml")]
+    pub config: PathBuf,
+    /// Override master-seed.
+    #[arg(long)]
+    pub seed: Option<u32>,
+    /// Camera position, world units with the planet centre at the origin.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,1200,3400", allow_hyphen_values = true)]
+    pub eye: glam::DVec3,
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
+    pub look_at: glam::DVec3,
+    /// Place the camera from the planet's own features instead of --eye/--look-at: `orbit` (the first river's
+    /// side of the planet), `mountains` (above the first river's source), `river` (close above the first river).
+    #[arg(long, value_enum, conflicts_with_all = ["eye", "look_at"])]
+    pub preset: Option<riverplanet::render::presets::Preset>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f64,
+    #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+    pub size: [u32; 2],
+    #[arg(long, value_enum, default_value = "auto")]
+    pub water: WaterMode,
+    #[arg(long, value_enum, default_value = "shaded")]
+    pub view: ViewMode,
+    #[arg(long, value_enum, default_value = "tiled")]
+    pub kernel: riverplanet::kernel::gpu::KernelVariant,
+    /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching, instead of nearest-point
+    /// selection with morphing.
+    #[arg(long)]
+    pub no_morphing: bool,
+    #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
+    pub clear_color: glam::DVec3,
+    /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_frames: u32,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    #[arg(long, default_value = "config/planet.xml")]
+    pub config: PathBuf,
+    #[arg(long)]
+    pub seed: Option<u32>,
+    #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+    pub size: [u32; 2],
+    /// Start position (default: the orbit preset).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<glam::DVec3>,
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
+    pub look_at: glam::DVec3,
+    #[arg(long, value_enum, default_value = "auto")]
+    pub water: WaterMode,
+    /// Run this many frames, then exit (with --screenshot, write it first).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// CPU single-thread, CPU rayon, GPU simple and GPU tiled on identical input (Tables 9.1/9.2): every river
+    /// patch the scripted flight meets, as one batch.
+    Kernel {
+        #[arg(long, default_value = "config/planet.xml")]
+        config: PathBuf,
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// The thesis's stress test: switch factor x10, camera x25.
+        #[arg(long)]
+        stress: bool,
+        /// Frames of the flight that produces the workload.
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
+        frames: u32,
+        /// Compare river data taken from the parent patch (10.2) with computing from scratch, on the patches of
+        /// the descent to the ground whose parents have the rivers' final detail (use config/earth.xml).
+        #[arg(long, conflicts_with = "stress")]
+        parent_reuse: bool,
+        /// Repetitions per variant (the median is reported).
+        #[arg(long, default_value_t = 5, value_parser = positive_count)]
+        repetitions: usize,
+        /// Invocations per workgroup of the simple kernel.
+        #[arg(long, default_value_t = KernelTuning::default().simple_workgroup)]
+        simple_workgroup: u32,
+        /// Vertex block per workgroup of the tiled kernel, as WxH [default: 8x4, KernelTuning::default()].
+        #[arg(long, value_parser = parse_block)]
+        tiled_block: Option<[u32; 2]>,
+        /// Samples staged per tile by the tiled kernel.
+        #[arg(long, default_value_t = KernelTuning::default().tile_size)]
+        tile_size: u32,
+        /// Write the report here as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+    /// The scripted flight from orbit to the surface, rendered headless, with per-frame statistics (Chapter 9).
+    Flight {
+        #[arg(long, default_value = "config/planet.xml")]
+        config: PathBuf,
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// The thesis's stress test: switch factor x10, camera x25.
+        #[arg(long)]
+        stress: bool,
+        /// Fly the descent from three radii out to two world units above the first river's water (the ground
+        /// preset) instead of the thesis's path.
+        #[arg(long, conflicts_with = "stress")]
+        descent: bool,
+        /// With --descent: write the frames whose hole check fails to DIR/holes-FRAME.png.
+        #[arg(long, requires = "descent")]
+        hole_images: Option<PathBuf>,
+        /// With --descent: write every tenth frame (those checked for holes) to DIR/frame-FRAME.png.
+        #[arg(long, requires = "descent")]
+        frame_images: Option<PathBuf>,
+        /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching.
+        #[arg(long)]
+        no_morphing: bool,
+        /// Compute every patch's river data from scratch, as the thesis (no data from the parent, 10.2).
+        #[arg(long)]
+        no_parent_reuse: bool,
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
+        frames: u32,
+        /// Camera speed factor (the stress test uses 25).
+        #[arg(long, default_value_t = 1.0, value_parser = positive_number, allow_hyphen_values = true)]
+        speed: f64,
+        #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+        size: [u32; 2],
+        /// Skip rerunning each frame's kernel input through all four variants.
+        #[arg(long)]
+        no_kernel_comparison: bool,
+        /// Skip the flights in the geometry and painted water modes.
+        #[arg(long)]
+        no_water_comparison: bool,
+        #[arg(long)]
+        json: PathBuf,
+        /// Leave the per-frame records out of the JSON (for very long flights).
+        #[arg(long)]
+        summary_only: bool,
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
+}
+
+fn parse_block(text: &str) -> Result<[u32; 2], String> {
+    let (w, h) = text
+        .split_once('x')
+        .ok_or_else(|| format!("'{text}' is not of the form WxH (e.g. 8x8)"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{text}' is not of the form WxH (e.g. 8x8)"))
+    };
+    Ok([parse(w)?, parse(h)?])
+}
+
+/// A whole number of at least 1.
+fn positive_count(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("'{text}' is not a whole number of at least 1")),
+    }
+}
+
+/// A finite number above 0.
+fn positive_number(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("'{text}' is not a finite number above 0")),
+    }
+}
+
+fn parse_vec3(text: &str) -> Result<glam::DVec3, String> {
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{text}' is not three comma-separated numbers (e.g. 0,1200,3400)"))?;
+    match parts.as_slice() {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok(glam::DVec3::new(*x, *y, *z)),
+        _ => Err(format!(
+            "'{text}' is not three comma-separated numbers (e.g. 0,1200,3400)"
+        )),
+    }
+}
+
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let [w, h] = parse_block(text)?;
+    if (1..=16384).contains(&w) && (1..=16384).contains(&h) {
+        Ok([w, h])
+    } else {
+        Err(format!("size '{text}' must be WxH with both in [1, 16384]"))
+    }
+}

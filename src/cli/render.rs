@@ -1,0 +1,126 @@
+//! `riverplanet render` (headless) and `riverplanet view` (the interactive viewer).
+
+use riverplanet::gpu::{self, Context, ContextOptions};
+
+use super::{RenderArgs, ViewArgs};
+use crate::{check_output, load_config};
+
+pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
+    let config = load_config(&args.config)?;
+    check_output("--out", &args.out, true)?;
+    let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
+    if args.preset.is_none() && args.eye.length() <= config.planet.radius as f64 * 0.5 {
+        anyhow::bail!(
+            "--eye {} is inside the planet (radius {})",
+            args.eye,
+            config.planet.radius
+        );
+    }
+    if (args.look_at - args.eye).length() < 1e-9 {
+        anyhow::bail!("--look-at must differ from --eye");
+    }
+    if !(1.0..=170.0).contains(&args.fov) {
+        anyhow::bail!("--fov {} must be in [1, 170] degrees", args.fov);
+    }
+    let world = riverplanet::world::World::build(&config, seed)?;
+    let (eye, look_at) = match args.preset {
+        Some(preset) => riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
+            anyhow::anyhow!("preset {preset:?} needs a river, and this planet has none")
+        })?,
+        None => (args.eye, args.look_at),
+    };
+    println!(
+        "camera: --eye {},{},{} --look-at {},{},{}",
+        eye.x, eye.y, eye.z, look_at.x, look_at.y, look_at.z
+    );
+    let ctx = Context::new(options)?;
+    let [w, h] = args.size;
+    let target = riverplanet::render::target::Offscreen::new(&ctx, w, h)?;
+    let mut renderer = riverplanet::render::Renderer::new(
+        &ctx,
+        &world.planet,
+        &world.network,
+        &config,
+        riverplanet::render::target::COLOR_FORMAT,
+        riverplanet::render::target::DEPTH_FORMAT,
+    )?;
+    renderer.water_mode = args.water;
+    renderer.view_mode = args.view;
+    renderer.variant = args.kernel;
+    renderer.morphing = !args.no_morphing;
+    let altitude = eye.length() - config.planet.radius as f64;
+    let camera = riverplanet::runtime::camera::Camera::look_at(
+        eye,
+        look_at,
+        args.fov,
+        w as f64 / h as f64,
+        (altitude * 0.05).clamp(0.01, 10.0),
+    );
+    let c = args.clear_color;
+    let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
+    let mut layout = gpu::vk::ImageLayout::UNDEFINED;
+    let (stats, frames) = renderer.render_until_streamed(
+        &camera,
+        &target.target(clear),
+        &mut layout,
+        args.max_frames,
+    )?;
+    let image = target.read(&ctx)?;
+    riverplanet::export::files::save_image(&image, &args.out)?;
+    println!(
+        "{}: {w}x{h}, {frames} frames to stream the patches; last frame: {} visible patches, {} resident, \
+         deepest level {}",
+        args.out.display(),
+        stats.visible_patches,
+        stats.resident_patches,
+        stats.deepest_level
+    );
+    for (pass, ms) in &stats.gpu_ms {
+        println!("  gpu {pass:<8} {ms:8.3} ms");
+    }
+    println!("  frame     {:8.3} ms", stats.frame_ms);
+    let errors = ctx.validation_errors();
+    renderer.destroy();
+    target.destroy(&ctx);
+    if !errors.is_empty() {
+        anyhow::bail!(
+            "validation reported {} error(s): {}",
+            errors.len(),
+            errors[0]
+        );
+    }
+    Ok(())
+}
+
+pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
+    let config = load_config(&args.config)?;
+    if let Some(path) = &args.screenshot {
+        check_output("--screenshot", path, true)?;
+    }
+    let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
+    let world = riverplanet::world::World::build(&config, seed)?;
+    let (eye, look_at) = match args.eye {
+        Some(eye) => (eye, args.look_at),
+        None => riverplanet::render::presets::camera(
+            riverplanet::render::presets::Preset::Orbit,
+            &world,
+        )
+        .unwrap_or((
+            glam::DVec3::new(0.0, 0.0, config.planet.radius as f64 * 3.0),
+            glam::DVec3::ZERO,
+        )),
+    };
+    riverplanet::render::viewer::run(
+        &world,
+        options,
+        riverplanet::render::viewer::ViewerOptions {
+            size: args.size,
+            eye,
+            look_at,
+            frames: args.frames,
+            screenshot: args.screenshot.clone(),
+            water: args.water,
+        },
+    )?;
+    Ok(())
+}
