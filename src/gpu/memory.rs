@@ -324,13 +324,4 @@ impl Context {
         self.deletion
             .collect(&self.device, &self.allocator, completed);
     }
-
-    /// Bytes allocated from the device, as gpu-allocator reports them.
-    pub fn allocated_bytes(&self) -> u64 {
-        self.allocator
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .generate_report()
-            .total_allocated_bytes
-    }
 }

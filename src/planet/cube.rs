@@ -19,8 +19,6 @@ pub const FACE_AXES: [(DVec3, DVec3, DVec3); FACES] = [
     (DVec3::NEG_Z, DVec3::NEG_X, DVec3::Y),
 ];
 
-pub const FACE_NAMES: [&str; FACES] = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"];
-
 /// The point of face `face` at (u, v) in [-1, 1]^2 on the cube of half-size 1.
 pub fn cube_point(face: usize, u: f64, v: f64) -> DVec3 {
     let (n, a, b) = FACE_AXES[face];

@@ -7,7 +7,6 @@
 //! distances are world units, exact at the centre and within a few percent over a river.
 
 use glam::{DVec2, DVec3};
-use serde::Serialize;
 
 use super::{
     hull,
@@ -317,15 +316,6 @@ pub struct RiverNetwork {
     pub samples_per_vertex_spacing: u32,
     /// Sources that found no river within `max-attempts` directions.
     pub abandoned_sources: usize,
-}
-
-/// Statistics of a network, for `stats.json`.
-#[derive(Clone, Debug, Serialize)]
-pub struct NetworkStats {
-    pub rivers: usize,
-    pub tributaries: usize,
-    pub abandoned_sources: usize,
-    pub generation_ms: f64,
 }
 
 impl RiverNetwork {
