@@ -503,7 +503,7 @@ impl Context {
 
 impl Drop for Context {
     fn drop(&mut self) {
-        // Shutdown order (STYLE.md): wait idle, flush deferred deletions, drop the allocator (it reports leaks),
+        // Shutdown order: wait idle, flush deferred deletions, drop the allocator (it reports leaks),
         // destroy device, messenger, instance.
         if let Err(e) = self.wait_idle() {
             log::error!("shutdown: {e}");

@@ -1,5 +1,5 @@
 //! GPU timestamps: a query pool of named begin/end pairs, reset from the host, read after the submission's
-//! completion, masked to `timestampValidBits` and scaled by `timestampPeriod` (as Granite's query pool does).
+//! completion, masked to `timestampValidBits` and scaled by `timestampPeriod`.
 //! Each scope is also a debug label, so captures show the same names.
 
 use ash::vk;
