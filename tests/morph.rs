@@ -42,19 +42,10 @@ fn key(patch: PatchId, n: u32, i: u32, j: u32) -> Key {
 
 /// Every drawn grid vertex, in world coordinates, by lattice point.
 fn surface(capture: &VertexCapture) -> HashMap<Key, DVec3> {
-    let n = capture.vertices;
     let mut out = HashMap::new();
-    for (patch, vertices) in &capture.patches {
-        for j in 0..n {
-            for i in 0..n {
-                let v = vertices[(j * n + i) as usize];
-                if v[3] > 0.0 {
-                    out.entry(key(*patch, n, i, j)).or_insert(
-                        capture.camera + DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64),
-                    );
-                }
-            }
-        }
+    for v in capture.drawn() {
+        out.entry(key(v.patch, capture.vertices, v.i, v.j))
+            .or_insert(capture.camera + v.relative);
     }
     out
 }
@@ -67,35 +58,27 @@ fn largest_jump(previous: &VertexCapture, next: &VertexCapture, radius: f64) -> 
     let before = surface(previous);
     let n = next.vertices;
     let (mut largest, mut compared) = (0.0f64, 0);
-    for (patch, vertices) in &next.patches {
+    for v in next.drawn() {
+        let (patch, i, j) = (v.patch, v.i, v.j);
         let spacing = radius * patch.size() / (n - 1) as f64;
-        for j in 0..n {
-            for i in 0..n {
-                let v = vertices[(j * n + i) as usize];
-                if v[3] <= 0.0 {
+        let here = next.camera + v.relative;
+        let expected = match before.get(&key(patch, n, i, j)) {
+            Some(p) => *p,
+            None => {
+                let (oi, oj) = (i % 2, j % 2);
+                if oi + oj == 0 || i < oi || j < oj || i + oi >= n || j + oj >= n {
                     continue;
                 }
-                let here = next.camera + DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-                let expected = match before.get(&key(*patch, n, i, j)) {
-                    Some(p) => *p,
-                    None => {
-                        let (oi, oj) = (i % 2, j % 2);
-                        if oi + oj == 0 || i < oi || j < oj || i + oi >= n || j + oj >= n {
-                            continue;
-                        }
-                        let ends = (
-                            before.get(&key(*patch, n, i - oi, j - oj)),
-                            before.get(&key(*patch, n, i + oi, j + oj)),
-                        );
-                        let (Some(a), Some(b)) = ends else { continue };
-                        let morph = (v[3] - 1.0) as f64;
-                        ((*a + *b) * 0.5).lerp(*a, morph)
-                    }
-                };
-                compared += 1;
-                largest = largest.max(here.distance(expected) / spacing);
+                let ends = (
+                    before.get(&key(patch, n, i - oi, j - oj)),
+                    before.get(&key(patch, n, i + oi, j + oj)),
+                );
+                let (Some(a), Some(b)) = ends else { continue };
+                ((*a + *b) * 0.5).lerp(*a, v.morph)
             }
-        }
+        };
+        compared += 1;
+        largest = largest.max(here.distance(expected) / spacing);
     }
     (largest, compared)
 }

@@ -6,6 +6,8 @@ mod common;
 
 use std::{collections::HashMap, path::Path};
 
+use glam::DVec3;
+
 use riverplanet::{
     config::Config,
     gpu::{bindless::Bindless, vk},
@@ -225,23 +227,16 @@ fn the_ground_view_draws_the_same_terrain_with_and_without_river_data_from_the_p
     let (scratch, none) = ground_vertices(false).unwrap();
     assert!(from_parent > 0, "no patch took river data from its parent");
     assert_eq!(none, 0);
-    let scratch: HashMap<PatchId, &Vec<[f32; 4]>> =
-        scratch.patches.iter().map(|(p, v)| (*p, v)).collect();
-    let (mut compared, mut worst) = (0, 0.0f32);
-    for (patch, vertices) in &reused.patches {
-        let Some(other) = scratch.get(patch) else {
-            continue;
-        };
-        // Vertices of quadrants drawn in both views.
-        for (a, b) in vertices
-            .iter()
-            .zip(other.iter())
-            .filter(|(a, b)| a[3] > 0.0 && b[3] > 0.0)
-        {
+    // Vertices drawn in both views, by instance patch and grid point.
+    let scratch: HashMap<(PatchId, u32, u32), DVec3> = scratch
+        .drawn()
+        .map(|v| ((v.patch, v.i, v.j), v.relative))
+        .collect();
+    let (mut compared, mut worst) = (0, 0.0f64);
+    for v in reused.drawn() {
+        if let Some(other) = scratch.get(&(v.patch, v.i, v.j)) {
             compared += 1;
-            for k in 0..3 {
-                worst = worst.max((a[k] - b[k]).abs());
-            }
+            worst = worst.max((v.relative - *other).abs().max_element());
         }
     }
     println!("{compared} vertices compared, largest difference {worst} m");

@@ -27,23 +27,11 @@ const MILLIMETRE: f64 = 1e-3;
 
 /// Every drawn grid vertex within `NEAR` of the camera: world position (f64) and morph factor, by (patch, i, j).
 fn near_vertices(capture: &VertexCapture) -> HashMap<(PatchId, u32, u32), (DVec3, f64)> {
-    let n = capture.vertices;
-    let mut out = HashMap::new();
-    for (patch, vertices) in &capture.patches {
-        for j in 0..n {
-            for i in 0..n {
-                let v = vertices[(j * n + i) as usize];
-                let relative = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-                if v[3] > 0.0 && relative.length() < NEAR {
-                    out.insert(
-                        (*patch, i, j),
-                        (capture.camera + relative, (v[3] - 1.0) as f64),
-                    );
-                }
-            }
-        }
-    }
-    out
+    capture
+        .drawn()
+        .filter(|v| v.relative.length() < NEAR)
+        .map(|v| ((v.patch, v.i, v.j), (capture.camera + v.relative, v.morph)))
+        .collect()
 }
 
 #[test]

@@ -56,6 +56,38 @@ pub struct VertexCapture {
     pub patches: Vec<(PatchId, Vec<[f32; 4]>)>,
 }
 
+/// One vertex of a drawn quadrant in a [`VertexCapture`].
+#[derive(Clone, Copy, Debug)]
+pub struct DrawnVertex {
+    pub patch: PatchId,
+    /// Its grid point in the patch.
+    pub i: u32,
+    pub j: u32,
+    /// Position relative to the capture's camera.
+    pub relative: DVec3,
+    /// Morph factor towards the parent, 0 to 1.
+    pub morph: f64,
+}
+
+impl VertexCapture {
+    /// Every grid vertex of a drawn quadrant (the captured `1 + morph` is positive), instance by instance.
+    pub fn drawn(&self) -> impl Iterator<Item = DrawnVertex> + '_ {
+        let n = self.vertices;
+        self.patches.iter().flat_map(move |(patch, vertices)| {
+            (0..n * n).filter_map(move |k| {
+                let v = vertices[k as usize];
+                (v[3] > 0.0).then(|| DrawnVertex {
+                    patch: *patch,
+                    i: k % n,
+                    j: k / n,
+                    relative: DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64),
+                    morph: (v[3] - 1.0) as f64,
+                })
+            })
+        })
+    }
+}
+
 /// What the recorded draws leave for after the frame: the vertex capture buffer and whose vertices it holds.
 pub(super) struct Drawn {
     capture: Option<Buffer>,

@@ -12,7 +12,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use self::draw::FramePush;
-pub use self::draw::{PatchInstance, VertexCapture};
+pub use self::draw::{DrawnVertex, PatchInstance, VertexCapture};
 use super::mesh::{patch_mesh, PatchMesh};
 use crate::{
     config::Config,
