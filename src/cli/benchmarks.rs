@@ -12,8 +12,7 @@ use crate::{check_output, check_validation, load_config, write_json};
 pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result<()> {
     match what {
         BenchCommand::Kernel {
-            config,
-            seed,
+            planet,
             stress,
             frames,
             parent_reuse,
@@ -23,11 +22,11 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             tile_size,
             json,
         } => {
-            let config = load_config(&config)?;
+            let config = load_config(&planet.config)?;
             if let Some(path) = &json {
                 check_output("--json", path, false)?;
             }
-            let world = riverplanet::world::World::build(&config, seed)?;
+            let world = riverplanet::world::World::build(&config, planet.seed)?;
             let ctx = Context::new(options)?;
             let tuning = KernelTuning {
                 simple_workgroup,
@@ -83,8 +82,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             Ok(())
         }
         BenchCommand::Flight {
-            config,
-            seed,
+            planet,
             stress,
             descent,
             hole_images,
@@ -101,7 +99,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             csv,
         } => {
             use std::io::IsTerminal;
-            let config = load_config(&config)?;
+            let config = load_config(&planet.config)?;
             for (argument, path) in [("--json", Some(&json)), ("--csv", csv.as_ref())] {
                 if let Some(path) = path {
                     check_output(argument, path, false)?;
@@ -111,7 +109,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 std::fs::create_dir_all(dir)
                     .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
             }
-            let world = riverplanet::world::World::build(&config, seed)?;
+            let world = riverplanet::world::World::build(&config, planet.seed)?;
             let ctx = Context::new(options)?;
             let bar = std::io::stderr()
                 .is_terminal()

@@ -166,15 +166,22 @@ pub struct ViewArgs {
     pub screenshot: Option<PathBuf>,
 }
 
+/// The planet a benchmark runs on.
+#[derive(clap::Args)]
+pub struct BenchPlanet {
+    #[arg(long, default_value = "config/planet.xml")]
+    pub config: PathBuf,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+}
+
 #[derive(Subcommand)]
 pub enum BenchCommand {
     /// CPU single-thread, CPU rayon, GPU simple and GPU tiled on identical input (Tables 9.1/9.2): every river
     /// patch the scripted flight meets, as one batch.
     Kernel {
-        #[arg(long, default_value = "config/planet.xml")]
-        config: PathBuf,
-        #[arg(long, default_value_t = 1)]
-        seed: u32,
+        #[command(flatten)]
+        planet: BenchPlanet,
         /// The thesis's stress test: switch factor x10, camera x25.
         #[arg(long)]
         stress: bool,
@@ -203,10 +210,8 @@ pub enum BenchCommand {
     },
     /// The scripted flight from orbit to the surface, rendered headless, with per-frame statistics (Chapter 9).
     Flight {
-        #[arg(long, default_value = "config/planet.xml")]
-        config: PathBuf,
-        #[arg(long, default_value_t = 1)]
-        seed: u32,
+        #[command(flatten)]
+        planet: BenchPlanet,
         /// The thesis's stress test: switch factor x10, camera x25.
         #[arg(long)]
         stress: bool,
