@@ -1,0 +1,210 @@
+//! The kernel outside the renderer: one batch end to end (textures, upload, dispatch, read-back), for the tests
+//! and the kernel benchmarks.
+
+use super::{create_river_texture, KernelBatch, KernelVariant, RiverKernel, RIVER_TEXTURE_LAYERS};
+use crate::{
+    gpu::{
+        bindless::{Bindless, Slot},
+        vk, Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler, ScopeTiming,
+    },
+    kernel::{KernelParams, ParentQuadrant, PatchJob, RiverTexel},
+};
+
+/// Decodes one read-back river texture (both layers, tightly packed RGBA32F) into texels.
+pub fn decode_texels(bytes: &[u8], grid_size: u32) -> Vec<RiverTexel> {
+    let texels: &[[f32; 4]] = bytemuck::cast_slice(bytes);
+    let (heights, widths) = texels.split_at((grid_size * grid_size) as usize);
+    heights
+        .iter()
+        .zip(widths)
+        .map(
+            |(&[terrain_height, lerp_factor, water_height, min_distance], width)| RiverTexel {
+                terrain_height,
+                lerp_factor,
+                water_height,
+                min_distance,
+                river_width: width[0],
+            },
+        )
+        .collect()
+}
+
+/// The result of [`run_batch`]: texels per patch and the GPU times of the scopes.
+pub struct BatchResult {
+    pub texels: Vec<Vec<RiverTexel>>,
+    pub timings: Vec<ScopeTiming>,
+    pub temporary_bytes: u64,
+}
+
+/// The output side of a batch: a river texture per patch, each in its bindless slot, and a host-visible buffer
+/// the textures are copied to. Benchmarks keep one between repetitions, as the renderer keeps its textures
+/// resident, so that repetitions measure the work and not the driver's first touch of fresh memory.
+pub struct BatchOutputs {
+    images: Vec<Image>,
+    slots: Vec<Slot>,
+    readback: Buffer,
+    grid_size: u32,
+}
+
+impl BatchOutputs {
+    /// Textures and read-back space for up to `patches` patches of `grid_size` x `grid_size` vertices.
+    pub fn new(
+        ctx: &Context,
+        bindless: &mut Bindless,
+        patches: usize,
+        grid_size: u32,
+    ) -> Result<Self, GpuError> {
+        let readback = ctx.create_buffer(&BufferDesc {
+            name: "river readback",
+            size: Self::texel_bytes(grid_size) * patches.max(1) as u64,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuToCpu,
+        })?;
+        let mut outputs = Self {
+            images: Vec::with_capacity(patches),
+            slots: Vec::with_capacity(patches),
+            readback,
+            grid_size,
+        };
+        for k in 0..patches {
+            let Some(slot) = bindless.allocate() else {
+                let capacity = bindless.capacity;
+                outputs.destroy(ctx, bindless);
+                return Err(GpuError::Invalid(format!(
+                    "batch of {patches} patches exceeds the {capacity} bindless slots"
+                )));
+            };
+            outputs.slots.push(slot);
+            let image = match create_river_texture(ctx, grid_size, &format!("river texture {k}")) {
+                Ok(image) => image,
+                Err(e) => {
+                    outputs.destroy(ctx, bindless);
+                    return Err(e);
+                }
+            };
+            bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            outputs.images.push(image);
+        }
+        Ok(outputs)
+    }
+
+    /// The bindless slots of the textures, in order.
+    pub fn slots(&self) -> &[Slot] {
+        &self.slots
+    }
+
+    /// Bytes of one patch's two layers, tightly packed.
+    fn texel_bytes(grid_size: u32) -> u64 {
+        (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
+    }
+
+    /// Frees the textures (after the GPU is done with them) and their slots.
+    pub fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
+        for s in self.slots {
+            bindless.release(s);
+        }
+        for i in self.images {
+            ctx.retire_image(i);
+        }
+        ctx.retire_buffer(self.readback);
+    }
+}
+
+/// Computes `jobs` on the GPU in one dispatch, end to end: textures, upload, dispatch, readback. The scope
+/// "kernel" times the dispatch alone. For tests; benchmarks reuse their outputs with [`run_batch_into`].
+pub fn run_batch(
+    ctx: &Context,
+    bindless: &mut Bindless,
+    kernel: &RiverKernel,
+    variant: KernelVariant,
+    jobs: &[PatchJob],
+    params: &KernelParams,
+) -> Result<BatchResult, GpuError> {
+    let outputs = BatchOutputs::new(ctx, bindless, jobs.len(), kernel.grid_size)?;
+    let result = run_batch_into(ctx, bindless, kernel, variant, jobs, &[], params, &outputs);
+    outputs.destroy(ctx, bindless);
+    result
+}
+
+/// [`run_batch`] into existing outputs (at least one texture per job): upload, dispatch, readback, decode.
+/// `parents` as in [`KernelBatch`].
+#[allow(clippy::too_many_arguments)]
+pub fn run_batch_into(
+    ctx: &Context,
+    bindless: &Bindless,
+    kernel: &RiverKernel,
+    variant: KernelVariant,
+    jobs: &[PatchJob],
+    parents: &[Option<(Slot, ParentQuadrant)>],
+    params: &KernelParams,
+    outputs: &BatchOutputs,
+) -> Result<BatchResult, GpuError> {
+    let n = kernel.grid_size;
+    if outputs.images.len() < jobs.len() || outputs.grid_size != n {
+        return Err(GpuError::Invalid(format!(
+            "batch of {} patches of {n}x{n} vertices does not fit outputs for {} patches of {}x{}",
+            jobs.len(),
+            outputs.images.len(),
+            outputs.grid_size,
+            outputs.grid_size
+        )));
+    }
+    let texel_bytes = BatchOutputs::texel_bytes(n);
+    let images = &outputs.images[..jobs.len()];
+    let slots = &outputs.slots[..jobs.len()];
+    let readback = &outputs.readback;
+    let mut profiler = Profiler::new(ctx, 2, "river kernel timestamps")?;
+    let image_refs: Vec<&Image> = images.iter().collect();
+    let result = ctx.run_and_wait("river kernel batch", |rec| {
+        let batch = KernelBatch {
+            textures: &image_refs,
+            slots,
+            jobs,
+            parents,
+        };
+        let scope = profiler.begin(rec, "kernel")?;
+        let bytes = kernel.record(rec, bindless, variant, &batch, params)?;
+        profiler.end(rec, scope);
+        rec.memory_barrier(
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_READ,
+        );
+        for (k, image) in images.iter().enumerate() {
+            rec.copy_image_to_buffer(
+                image,
+                vk::ImageLayout::GENERAL,
+                readback,
+                k as u64 * texel_bytes,
+            );
+        }
+        rec.buffer_barrier(
+            readback,
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+        Ok(bytes)
+    });
+    let outcome = result.and_then(|temporary_bytes| {
+        let timings = profiler.read(ctx)?;
+        let bytes = readback
+            .mapped()
+            .ok_or_else(|| GpuError::Invalid("readback buffer is not host-visible".into()))?;
+        let texels = (0..jobs.len())
+            .map(|k| {
+                let start = k * texel_bytes as usize;
+                decode_texels(&bytes[start..start + texel_bytes as usize], n)
+            })
+            .collect();
+        Ok(BatchResult {
+            texels,
+            timings,
+            temporary_bytes,
+        })
+    });
+    profiler.destroy(ctx);
+    outcome
+}

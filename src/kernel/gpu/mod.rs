@@ -1,0 +1,310 @@
+//! The GPU river kernel (Chapter 7): the simple (7.3.1) and tiled (7.3.2) compute shaders, and the recording of
+//! the dispatch that computes every new patch of a frame. A range table (one [`GpuPatchJob`] per patch, four for a
+//! patch that takes river data from its parent) maps the workgroups' row index to the sample range, the output
+//! slot and the vertices of the row.
+
+mod batch;
+mod jobs;
+mod tuning;
+
+use bytemuck::{Pod, Zeroable};
+
+pub use self::{
+    batch::{decode_texels, run_batch, run_batch_into, BatchOutputs, BatchResult},
+    jobs::{range_table, GpuPatchJob, RangeTable, NO_PARENT},
+    tuning::{tiled_shared_bytes, KernelTuning},
+};
+use super::{KernelParams, ParentQuadrant, PatchJob, RiverSample};
+use crate::{
+    gpu::{
+        bindless::{Bindless, Slot},
+        pipeline::{BufferSetLayout, ComputePipeline},
+        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+    },
+    shaders,
+};
+
+/// Which compute shader runs the kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+pub enum KernelVariant {
+    /// One invocation per vertex, samples read from the storage buffer (7.3.1).
+    Simple,
+    /// Samples staged in shared memory tile by tile (7.3.2).
+    Tiled,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct PushParams {
+    influence_distance: f32,
+    basin_depth: f32,
+    sea_level: f32,
+    basin_water_offset: f32,
+    grid_size: u32,
+    first_job: u32,
+}
+
+/// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
+/// minimum distance), layer 1 = (river half width, 0, 0, 0).
+pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const RIVER_TEXTURE_LAYERS: u32 = 2;
+
+/// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
+/// spacing and samples; and for jobs that take their even vertices from their parent (10.2), the parent's slot
+/// (its river texture in the GENERAL layout) and quadrant. `parents` is empty or as long as `jobs`.
+#[derive(Clone, Copy)]
+pub struct KernelBatch<'a> {
+    pub textures: &'a [&'a Image],
+    pub slots: &'a [Slot],
+    pub jobs: &'a [PatchJob<'a>],
+    pub parents: &'a [Option<(Slot, ParentQuadrant)>],
+}
+
+/// Both kernel pipelines, ready to record dispatches.
+pub struct RiverKernel {
+    simple: ComputePipeline,
+    /// The tiled kernel's pre-pass: which samples reach which vertex block (kernel_reach.comp).
+    reach: ComputePipeline,
+    tiled: ComputePipeline,
+    /// Samples and range table (simple); plus the reach masks (reach pre-pass and tiled).
+    inputs: BufferSetLayout,
+    tiled_inputs: BufferSetLayout,
+    pub grid_size: u32,
+    pub tuning: KernelTuning,
+}
+
+impl RiverKernel {
+    pub fn new(
+        ctx: &Context,
+        bindless: &Bindless,
+        grid_size: u32,
+        tuning: KernelTuning,
+    ) -> Result<Self, GpuError> {
+        tuning.validate(ctx).map_err(GpuError::Invalid)?;
+        let inputs = BufferSetLayout::new(ctx, 2, "river kernel inputs")?;
+        let tiled_inputs = BufferSetLayout::new(ctx, 3, "tiled river kernel inputs")?;
+        let layouts = [bindless.layout, inputs.layout];
+        let tiled_layouts = [bindless.layout, tiled_inputs.layout];
+        let push = std::mem::size_of::<PushParams>() as u32;
+        let simple = ComputePipeline::new(
+            ctx,
+            shaders::KERNEL_SIMPLE_COMP,
+            "river kernel simple",
+            &layouts,
+            push,
+            &[tuning.simple_workgroup],
+        )?;
+        let reach = ComputePipeline::new(
+            ctx,
+            shaders::KERNEL_REACH_COMP,
+            "river kernel reach masks",
+            &tiled_layouts,
+            push,
+            &tuning.tiled_block,
+        )?;
+        let tiled = ComputePipeline::with_full_subgroups(
+            ctx,
+            shaders::KERNEL_TILED_COMP,
+            "river kernel tiled",
+            &tiled_layouts,
+            push,
+            &[
+                tuning.tiled_invocations(),
+                tuning.tiled_block[0],
+                tuning.tiled_block[1],
+                tuning.tile_size,
+                ctx.subgroup.max_size,
+            ],
+            ctx.subgroup.max_size,
+        )?;
+        Ok(Self {
+            simple,
+            reach,
+            tiled,
+            inputs,
+            tiled_inputs,
+            grid_size,
+            tuning,
+        })
+    }
+
+    /// Records one dispatch computing every job of `batch` into its slot's river texture. The textures are fresh
+    /// (any layout): they are moved to GENERAL here. The sample and range-table buffers are host-visible
+    /// per-dispatch buffers, freed when the submission completes. Returns their size in bytes (the frame's
+    /// temporary sample memory). The caller makes the results visible to whatever reads them next.
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        bindless: &Bindless,
+        variant: KernelVariant,
+        batch: &KernelBatch,
+        params: &KernelParams,
+    ) -> Result<u64, GpuError> {
+        rec.image_transitions(
+            batch.textures,
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::GENERAL,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        );
+        if batch.jobs.is_empty() {
+            return Ok(0);
+        }
+        if batch.parents.iter().any(Option::is_some) {
+            // The parents' river textures were written by an earlier dispatch.
+            rec.memory_barrier(
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ,
+            );
+        }
+        let ctx = rec.ctx();
+        let host_buffer = |name: &str, size: usize| {
+            ctx.create_buffer(&BufferDesc {
+                name,
+                size: size.max(16) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::CpuToGpu,
+            })
+        };
+        let n = self.grid_size;
+        let table = range_table(batch, n, self.tuning.tiled_block);
+        let rows = &table.rows;
+        let mut job_buffer = host_buffer("river range table", std::mem::size_of_val(&rows[..]))?;
+        job_buffer.write(0, rows)?;
+        // Every patch's samples are written straight into the mapped buffer at its range.
+        let sample_bytes = std::mem::size_of::<RiverSample>();
+        let total: usize = batch.jobs.iter().map(|j| j.samples.len()).sum();
+        let mut sample_buffer = host_buffer("river samples", total * sample_bytes)?;
+        for (job, offset) in batch.jobs.iter().zip(&table.sample_offsets) {
+            sample_buffer.write(*offset as usize * sample_bytes, job.samples)?;
+        }
+        let bytes = sample_buffer.size + job_buffer.size;
+        // Rows over whole patches, then rows over every second vertex (from the parent's patches).
+        let half = n.div_ceil(2);
+        let groups = [
+            (0, table.full_rows, [n, n]),
+            (table.full_rows, rows.len() - table.full_rows, [half, half]),
+        ];
+        let push = |first_job: usize| PushParams {
+            influence_distance: params.influence_distance,
+            basin_depth: params.basin_depth,
+            sea_level: params.sea_level,
+            basin_water_offset: params.basin_water_offset,
+            grid_size: n,
+            first_job: first_job as u32,
+        };
+        let inputs = [&sample_buffer, &job_buffer];
+        let dispatched = match variant {
+            KernelVariant::Simple => rec.buffer_set(&self.inputs, &inputs).map(|set| {
+                for (first, count, [x, y]) in groups.into_iter().filter(|g| g.1 > 0) {
+                    let size = [
+                        (x * y).div_ceil(self.tuning.simple_workgroup),
+                        count as u32,
+                        1,
+                    ];
+                    let push = push(first);
+                    rec.dispatch(
+                        &self.simple,
+                        &[bindless.set, set],
+                        bytemuck::bytes_of(&push),
+                        size,
+                    );
+                }
+                0
+            }),
+            KernelVariant::Tiled => self.record_tiled(rec, bindless, inputs, &table, groups, push),
+        };
+        rec.free_after_completion(sample_buffer);
+        rec.free_after_completion(job_buffer);
+        Ok(bytes + dispatched?)
+    }
+
+    /// The tiled variant: clears the reach masks, runs the pre-pass that fills them, then the tiled kernel over
+    /// each group of rows (first row, rows, lattice size). Returns the size of the mask buffer, which is freed
+    /// when the submission completes.
+    fn record_tiled(
+        &self,
+        rec: &mut Recorder,
+        bindless: &Bindless,
+        [samples, table_buffer]: [&Buffer; 2],
+        table: &RangeTable,
+        groups: [(usize, usize, [u32; 2]); 2],
+        push: impl Fn(usize) -> PushParams,
+    ) -> Result<u64, GpuError> {
+        let [bx, by] = self.tuning.tiled_block;
+        let masks = rec.ctx().create_buffer(&BufferDesc {
+            name: "river reach masks",
+            size: (table.mask_words * 4).max(16),
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        let size = masks.size;
+        let set = rec.buffer_set(&self.tiled_inputs, &[samples, table_buffer, &masks]);
+        if let Ok(set) = set {
+            rec.fill_buffer(&masks, 0);
+            rec.buffer_barrier(
+                &masks,
+                vk::PipelineStageFlags2::CLEAR,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            );
+            let rows = table.rows.len() as u32;
+            rec.dispatch(
+                &self.reach,
+                &[bindless.set, set],
+                bytemuck::bytes_of(&push(0)),
+                [1, rows, 1],
+            );
+            rec.buffer_barrier(
+                &masks,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ,
+            );
+            for (first, count, [x, y]) in groups.into_iter().filter(|g| g.1 > 0) {
+                let size = [x.div_ceil(bx), y.div_ceil(by), count as u32];
+                let push = push(first);
+                rec.dispatch(
+                    &self.tiled,
+                    &[bindless.set, set],
+                    bytemuck::bytes_of(&push),
+                    size,
+                );
+            }
+        }
+        rec.free_after_completion(masks);
+        set.map(|_| size)
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.simple.destroy(ctx);
+        self.reach.destroy(ctx);
+        self.tiled.destroy(ctx);
+        self.inputs.destroy(ctx);
+        self.tiled_inputs.destroy(ctx);
+    }
+}
+
+/// Creates one patch's river texture.
+pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result<Image, GpuError> {
+    ctx.create_image(&ImageDesc {
+        name,
+        extent: vk::Extent2D {
+            width: grid_size,
+            height: grid_size,
+        },
+        layers: RIVER_TEXTURE_LAYERS,
+        format: RIVER_TEXTURE_FORMAT,
+        usage: vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC,
+        aspect: vk::ImageAspectFlags::COLOR,
+        array: true,
+    })
+}
