@@ -134,12 +134,12 @@ pub struct Config {
 }
 
 impl Config {
-    /// The defaults of `model`: Appendix A's values (`Default`) for the thesis's model; for the drainage model the
-    /// values config/drainage.xml was tuned with (docs/rivers.md): a river where 700 square units drain, a quarter
+    /// The defaults of `model`: Appendix A's values for the thesis's model (`appendix_a`); for the drainage model
+    /// the values config/planet.xml was tuned with (docs/rivers.md): a river where 700 square units drain, a quarter
     /// of the diamond-square detail (the relief carries the shape), and at most four samples per vertex spacing (a
     /// thousand rivers would give coarse patches millions of samples).
     pub fn defaults_for(model: RiverModel) -> Self {
-        let mut d = Self::default();
+        let mut d = Self::appendix_a();
         d.river.model = model;
         if model == RiverModel::Drainage {
             d.planet.detail_amplitude = 2.0;
@@ -148,11 +148,10 @@ impl Config {
         }
         d
     }
-}
 
-impl Default for Config {
-    /// The values of Appendix A (with `master-seed` 1 instead of -1 so the default planet is reproducible).
-    fn default() -> Self {
+    /// The values of Appendix A with the thesis's river model (and `master-seed` 1 instead of -1 so the planet is
+    /// reproducible): the planet of the thesis's Chapter 9 experiments.
+    pub fn appendix_a() -> Self {
         Self {
             planet: PlanetConfig {
                 radius: 1024.0,
@@ -200,6 +199,14 @@ impl Default for Config {
                 resident_memory_mb: 256,
             },
         }
+    }
+}
+
+impl Default for Config {
+    /// The product's default: Appendix A's planet with the drainage model (docs/rivers.md), the planet of
+    /// config/planet.xml. The thesis's model is `Config::appendix_a()` and config/thesis.xml.
+    fn default() -> Self {
+        Self::defaults_for(RiverModel::Drainage)
     }
 }
 

@@ -58,12 +58,13 @@ fn generate_writes_face_images_at_the_chosen_level_or_names_the_valid_range() {
 }
 
 #[test]
-fn generate_writes_faces_layout_stats_rivers_and_preview() {
+fn generate_with_the_thesis_model_writes_faces_layout_stats_rivers_and_preview() {
     let dir = temp_dir("generate");
     let config = dir.join("small.xml");
     std::fs::write(
         &config,
         "<planet><planet-attributes><base-resolution>65</base-resolution></planet-attributes>\
+         <river-attributes><river-model>thesis</river-model></river-attributes>\
          <rendering-attributes><max-level-of-detail>3</max-level-of-detail></rendering-attributes></planet>",
     )
     .unwrap();
@@ -185,7 +186,7 @@ fn the_ground_preset_reaches_deep_levels_made_on_demand() {
 #[test]
 fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
     let dir = temp_dir("generate-drainage");
-    let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/drainage.xml");
+    let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml");
     let run = riverplanet()
         .args([
             "generate",

@@ -1,8 +1,8 @@
 //! The XML configuration: Appendix A as printed, and every class of bad input reported by element and range.
 
-use riverplanet::config::{Config, ConfigError};
+use riverplanet::config::{Config, ConfigError, RiverModel};
 
-const APPENDIX_A: &str = include_str!("../config/planet.xml");
+const APPENDIX_A: &str = include_str!("../config/thesis.xml");
 
 fn with(section: &str, element: &str, value: &str) -> String {
     let open = format!("<{element}>");
@@ -24,7 +24,8 @@ fn error_of(xml: &str) -> String {
 
 #[test]
 fn appendix_a_reads_as_printed() {
-    let c = Config::parse(APPENDIX_A, "config/planet.xml").expect("Appendix A must parse");
+    let c = Config::parse(APPENDIX_A, "config/thesis.xml").expect("Appendix A must parse");
+    assert_eq!(c.river.model, RiverModel::Thesis);
     assert_eq!(c.planet.radius, 1024.0);
     assert_eq!(c.planet.continents, 5);
     assert_eq!(c.planet.landmass_percentage, 30.0);
@@ -49,9 +50,29 @@ fn appendix_a_reads_as_printed() {
 }
 
 #[test]
-fn the_shipped_file_loads_from_disk() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml");
-    Config::load(&path).unwrap();
+fn the_shipped_files_load_from_disk_with_their_models() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
+    for (file, model) in [
+        ("planet.xml", RiverModel::Drainage),
+        ("thesis.xml", RiverModel::Thesis),
+        ("earth.xml", RiverModel::Thesis),
+    ] {
+        assert_eq!(
+            Config::load(&dir.join(file)).unwrap().river.model,
+            model,
+            "{file}"
+        );
+    }
+}
+
+#[test]
+fn without_a_river_model_the_drainage_model_and_its_defaults_apply() {
+    let c = Config::parse("<planet></planet>", "t.xml").unwrap();
+    assert_eq!(c.river.model, RiverModel::Drainage);
+    assert_eq!(c.river.source_area, 700.0);
+    assert_eq!(Config::default().river.model, RiverModel::Drainage);
+    assert_eq!(Config::appendix_a().river.model, RiverModel::Thesis);
+    assert_eq!(Config::appendix_a().planet.detail_amplitude, 8.0);
 }
 
 #[test]
@@ -183,7 +204,7 @@ fn the_river_model_is_named_or_refused() {
         "t.xml",
     )
     .unwrap();
-    assert_eq!(c.river.model, riverplanet::config::RiverModel::Drainage);
+    assert_eq!(c.river.model, RiverModel::Drainage);
     let message = error_of(&with("river-attributes", "river-model", "rain"));
     assert!(
         message.contains("river-model") && message.contains("thesis, drainage"),

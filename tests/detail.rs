@@ -19,7 +19,7 @@ use riverplanet::{
 /// A planet whose precomputed lattice is level 4 and whose base lattice is level 1, so that levels 2-4 exist both
 /// as the whole-face diamond-square and as per-patch refinement.
 fn planet(max_level: u32, seed: u32) -> Planet {
-    let mut c = Config::default();
+    let mut c = Config::appendix_a();
     c.rendering.max_level_of_detail = max_level;
     c.planet.base_resolution = 65;
     Planet::generate(&c, seed, |_| {}).unwrap()

@@ -142,7 +142,7 @@ fn a_pit_becomes_a_lake_at_its_spill_height_and_rivers_form_trees() {
 
 fn drainage_config() -> riverplanet::config::Config {
     riverplanet::config::Config::load(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/drainage.xml"),
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml"),
     )
     .unwrap()
 }

@@ -22,7 +22,7 @@ use riverplanet::{
 
 fn world() -> &'static World {
     static WORLD: OnceLock<World> = OnceLock::new();
-    WORLD.get_or_init(|| World::build(&Config::default(), 1).unwrap())
+    WORLD.get_or_init(|| World::build(&Config::appendix_a(), 1).unwrap())
 }
 
 /// Lattice points as integers at this level, whatever the level of the patch that draws them.

@@ -11,7 +11,7 @@ use riverplanet::{
 
 /// A small planet for fast tests: max level 3 (precomputed lattice 257 cells per face).
 fn small_config(landmass: f32) -> Config {
-    let mut c = Config::default();
+    let mut c = Config::appendix_a();
     c.rendering.max_level_of_detail = 3;
     c.planet.base_resolution = 65;
     c.planet.landmass_percentage = landmass;
@@ -287,7 +287,7 @@ fn base_resolution_must_fit_the_patch_grid() {
 
 #[test]
 fn tiny_grids_generate_without_panicking() {
-    let mut c = Config::default();
+    let mut c = Config::appendix_a();
     c.rendering.vertices = 5;
     c.rendering.max_level_of_detail = 2;
     c.planet.base_resolution = 9;

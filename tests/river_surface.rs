@@ -18,7 +18,7 @@ const LEVEL: u8 = 6;
 
 /// How far the water may stand above the drawn terrain beside it, in height units. The kernel averages the river
 /// bed over the influence distance (Procedures 4-5), so where a river falls steeply (towards a coast) the water
-/// at its centre stands above banks a few units up- or downstream; on config/drainage.xml seed 1 that is at most
+/// at its centre stands above banks a few units up- or downstream; on config/planet.xml seed 1 that is at most
 /// 0.49. The thesis's rivers, which cross the relief, stand up to 2.88 above their banks on the same planet.
 const BANK_TOLERANCE: f64 = 0.75;
 /// How much the water may rise from one checked point to the next downstream (the kernel's averaging over
@@ -122,7 +122,7 @@ fn survey(world: &World) -> Findings {
 
 fn world(model: RiverModel) -> World {
     let mut config =
-        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/drainage.xml")).unwrap();
+        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml")).unwrap();
     config.river.model = model;
     World::build(&config, 1).unwrap()
 }
@@ -160,7 +160,7 @@ fn the_thesis_rivers_fail_the_bank_check() {
 }
 
 /// Lake water: at the lake's level, except where a river flows in and the kernel's average over the influence
-/// distance lifts the water towards the river's (0.17 at most on config/drainage.xml seed 1).
+/// distance lifts the water towards the river's (0.17 at most on config/planet.xml seed 1).
 const LAKE_TOLERANCE: f64 = 0.2;
 
 #[test]

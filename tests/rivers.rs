@@ -16,7 +16,7 @@ use riverplanet::{
 const SEED: u32 = 11;
 
 fn config() -> Config {
-    let mut c = Config::default();
+    let mut c = Config::appendix_a();
     c.rendering.max_level_of_detail = 4;
     c.planet.base_resolution = 129;
     c

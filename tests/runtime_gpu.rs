@@ -25,7 +25,7 @@ use riverplanet::{
 fn world() -> &'static World {
     static WORLD: OnceLock<World> = OnceLock::new();
     WORLD.get_or_init(|| {
-        let mut c = Config::default();
+        let mut c = Config::appendix_a();
         c.rendering.max_level_of_detail = 5;
         World::build(&c, 2).unwrap()
     })
