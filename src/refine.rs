@@ -303,14 +303,14 @@ pub fn generate_on_gpu(
     let mut slots: HashMap<PatchId, Slot> = HashMap::new();
     let release = |images: Vec<Image>, slots: HashMap<PatchId, Slot>, bindless: &mut Bindless| {
         for s in slots.into_values() {
-            bindless.release(s);
+            bindless.release(ctx, s);
         }
         for i in images {
             ctx.retire_image(i);
         }
     };
     for p in &all {
-        let Some(slot) = bindless.allocate() else {
+        let Some(slot) = bindless.allocate(ctx) else {
             let capacity = bindless.capacity;
             release(images, slots, bindless);
             return Err(GpuError::Invalid(format!(

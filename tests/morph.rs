@@ -123,6 +123,7 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
                 &[],
             )
             .unwrap();
+        renderer.finish().unwrap();
         let capture = renderer.last_capture.take().expect("vertices captured");
         if let Some(p) = &previous {
             let (jump, count) = largest_jump(p, &capture, r);

@@ -18,7 +18,7 @@ use crate::{
     kernel::{gpu::KernelTuning, KernelParams, PatchJob},
     render::{
         target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
-        FrameStats, Renderer, WaterMode,
+        FrameStats, GpuTimes, Renderer, WaterMode,
     },
     world::World,
 };
@@ -109,6 +109,7 @@ pub struct FlightReport {
     pub descent: bool,
     pub morphing: bool,
     pub parent_reuse: bool,
+    pub frames_in_flight: usize,
     pub river_model: crate::config::RiverModel,
     pub radius: f64,
     pub seed: u32,
@@ -143,6 +144,8 @@ pub struct FlightOptions {
     pub parent_reuse: bool,
     /// Where to write every checked frame of the descent (`frame-FRAME.png`, with its altitude in the report).
     pub frame_images: Option<std::path::PathBuf>,
+    /// Frames the CPU may record ahead of the GPU (1: the thesis's wait for every frame).
+    pub frames_in_flight: usize,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -176,6 +179,7 @@ fn fly(
     renderer.water_mode = water;
     renderer.morphing = options.morphing;
     renderer.parent_reuse = options.parent_reuse;
+    renderer.set_frames_in_flight(options.frames_in_flight)?;
     renderer.capture_batches = runner.is_some();
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
@@ -196,7 +200,8 @@ fn fly(
     let result = (|| {
         for frame in 0..options.frames {
             let camera = flight.camera(world, frame);
-            let stats = renderer.render(
+            let start = std::time::Instant::now();
+            let mut stats = renderer.render(
                 &camera,
                 &target.target(if options.descent {
                     HOLE_COLOUR
@@ -208,6 +213,13 @@ fn fly(
                 &[],
             )?;
             layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+            let compare = runner.is_some() && !renderer.last_batch.is_empty();
+            let check_holes = options.descent && frame % HOLE_CHECK_EVERY == 0;
+            if compare || check_holes {
+                // The benchmark's own work waits for the GPU; the wait for this frame is the frame's.
+                renderer.finish()?;
+                stats.frame_ms = start.elapsed().as_secs_f64() * 1e3;
+            }
             let kernels = match (&mut runner, renderer.last_batch.is_empty()) {
                 (Some(runner), false) => {
                     let jobs = PatchJob::from_pairs(&renderer.last_batch);
@@ -223,7 +235,7 @@ fn fly(
                 }
                 _ => None,
             };
-            let hole_pixels = if options.descent && frame % HOLE_CHECK_EVERY == 0 {
+            let hole_pixels = if check_holes {
                 let image = target.read(ctx)?;
                 let holes = hole_pixels(&image, &camera, inner).0;
                 let save = |dir: &std::path::Path, name: String| {
@@ -244,17 +256,38 @@ fn fly(
             let altitude = camera.position.length() - world.planet.radius;
             frames.push(FlightFrame {
                 altitude,
-                stats,
+                stats: FrameStats {
+                    gpu_ms: BTreeMap::new(),
+                    ..stats
+                },
                 kernels,
                 hole_pixels,
             });
+            attribute_gpu_times(&mut frames, renderer.take_gpu_times());
             progress(frame);
         }
+        // The frames still in flight end the flight: their wait is the last frame's.
+        let start = std::time::Instant::now();
+        renderer.finish()?;
+        if let Some(last) = frames.last_mut() {
+            last.stats.frame_ms += start.elapsed().as_secs_f64() * 1e3;
+        }
+        attribute_gpu_times(&mut frames, renderer.take_gpu_times());
         Ok(())
     })();
     renderer.destroy();
     target.destroy(ctx);
     result.map(|()| frames)
+}
+
+/// Puts each finished frame's GPU times into its own frame's statistics: they arrive one or two frames late.
+fn attribute_gpu_times(frames: &mut [FlightFrame], times: Vec<GpuTimes>) {
+    for t in times {
+        if let Some(f) = frames.iter_mut().rev().find(|f| f.stats.frame == t.frame) {
+            f.stats.gpu_ms = t.ms;
+            f.stats.gpu_frame = t.frame;
+        }
+    }
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
@@ -429,6 +462,7 @@ pub fn flight_bench(
         descent: options.descent,
         morphing: options.morphing,
         parent_reuse: options.parent_reuse,
+        frames_in_flight: options.frames_in_flight,
         river_model: config.river.model,
         radius: world.planet.radius,
         seed: world.seed,

@@ -89,6 +89,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             frame_images,
             no_morphing,
             no_parent_reuse,
+            frames_in_flight,
             frames,
             speed,
             size,
@@ -126,6 +127,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 frame_images,
                 morphing: !no_morphing,
                 parent_reuse: !no_parent_reuse,
+                frames_in_flight,
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {

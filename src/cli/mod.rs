@@ -231,6 +231,11 @@ pub enum BenchCommand {
         /// Compute every patch's river data from scratch, as the thesis (no data from the parent, 10.2).
         #[arg(long)]
         no_parent_reuse: bool,
+        /// Frames the CPU may record ahead of the GPU (1: wait for every frame before the next, as the thesis).
+        #[arg(long, default_value_t = riverplanet::gpu::frames::FRAMES_IN_FLIGHT,
+              value_parser = clap::builder::RangedU64ValueParser::<usize>::new()
+                  .range(1..=riverplanet::gpu::frames::MAX_FRAMES_IN_FLIGHT as u64))]
+        frames_in_flight: usize,
         #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
         frames: u32,
         /// Camera speed factor (the stress test uses 25).

@@ -7,6 +7,9 @@ use ash::vk;
 
 use super::{Context, GpuError, Image, VkResultExt};
 
+/// The debug name of the set, which validation messages quote.
+pub(crate) const SET_NAME: &str = "bindless set";
+
 pub const STORAGE_IMAGES: u32 = 0;
 pub const SAMPLED_IMAGES: u32 = 1;
 
@@ -17,6 +20,9 @@ pub struct Bindless {
     sampler: vk::Sampler,
     pub capacity: u32,
     free: Vec<u32>,
+    /// Released slots with the timeline value after which no submitted frame reads them: a frame still in
+    /// flight may read a slot's descriptor, which must not be rewritten until that frame has finished.
+    released: std::collections::VecDeque<(u64, u32)>,
 }
 
 /// A slot index in the bindless arrays, as shaders see it.
@@ -98,7 +104,7 @@ impl Bindless {
             .push_next(&mut variable);
         let set = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .vk("vkAllocateDescriptorSets")?[0];
-        ctx.set_name(set, "bindless set");
+        ctx.set_name(set, SET_NAME);
         let sampler_info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::LINEAR)
             .min_filter(vk::Filter::LINEAR)
@@ -115,18 +121,43 @@ impl Bindless {
             sampler,
             capacity,
             free: (0..capacity).rev().collect(),
+            released: Default::default(),
         })
     }
 
-    /// Takes a free slot, or `None` when all are in use.
-    pub fn allocate(&mut self) -> Option<Slot> {
+    /// Takes a free slot (reclaiming released ones whose frames have finished when none is left), or `None` when
+    /// all are in use or still read by frames in flight.
+    pub fn allocate(&mut self, ctx: &Context) -> Option<Slot> {
+        if self.free.is_empty() {
+            self.reclaim(ctx);
+        }
         self.free.pop().map(Slot)
     }
 
-    /// Returns a slot. Its old descriptors stay until overwritten; PARTIALLY_BOUND makes that legal.
-    pub fn release(&mut self, slot: Slot) {
+    /// Returns a slot once every submission made so far has completed (`reclaim`). Its old descriptors stay until
+    /// overwritten; PARTIALLY_BOUND makes that legal.
+    pub fn release(&mut self, ctx: &Context, slot: Slot) {
         debug_assert!(!self.free.contains(&slot.0));
-        self.free.push(slot.0);
+        self.released
+            .push_back((ctx.timeline.last_submitted(), slot.0));
+    }
+
+    /// Makes the released slots whose submissions have completed free again.
+    fn reclaim(&mut self, ctx: &Context) {
+        // A failed query (device loss) reclaims nothing; the next submission reports the loss.
+        let completed = ctx.timeline.completed(&ctx.device).unwrap_or(0);
+        while let Some(&(value, slot)) = self.released.front() {
+            if value > completed {
+                break;
+            }
+            self.free.push(slot);
+            self.released.pop_front();
+        }
+    }
+
+    /// Slots released but still read by frames in flight.
+    pub fn pending_release(&self) -> usize {
+        self.released.len()
     }
 
     /// Points `slot` at `image`: as a storage image in GENERAL layout (if `storage`), and as a sampled image in

@@ -20,6 +20,8 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 pub struct ContextOptions {
     /// Enable the Khronos validation layer and collect its errors.
     pub validation: bool,
+    /// With `validation`: also synchronization validation (hazards between commands, across submissions).
+    pub synchronization_validation: bool,
     /// Choose the first device whose name contains this (case-insensitive).
     pub adapter: Option<String>,
     /// Extra instance extensions (surface extensions for a window).
@@ -29,16 +31,18 @@ pub struct ContextOptions {
 }
 
 impl ContextOptions {
-    /// Options from the environment: `RIVERPLANET_VALIDATION` (0/1, default on in debug builds) and
-    /// `RIVERPLANET_ADAPTER`.
+    /// Options from the environment: `RIVERPLANET_VALIDATION` (0/1, or `sync` for synchronization validation too;
+    /// default on in debug builds) and `RIVERPLANET_ADAPTER`.
     pub fn from_env() -> Self {
-        let validation = match std::env::var("RIVERPLANET_VALIDATION").as_deref() {
+        let setting = std::env::var("RIVERPLANET_VALIDATION");
+        let validation = match setting.as_deref() {
             Ok("0") | Ok("false") | Ok("off") => false,
             Ok(_) => true,
             Err(_) => cfg!(debug_assertions),
         };
         Self {
             validation,
+            synchronization_validation: setting.as_deref() == Ok("sync"),
             adapter: std::env::var("RIVERPLANET_ADAPTER")
                 .ok()
                 .filter(|s| !s.is_empty()),
@@ -63,6 +67,17 @@ pub struct AdapterInfo {
 #[derive(Default)]
 pub struct ValidationLog {
     errors: Mutex<Vec<String>>,
+    /// Synchronization hazards reported through the bindless set's runtime arrays, which are not counted as errors
+    /// (`is_runtime_array_hazard`).
+    waived: std::sync::atomic::AtomicUsize,
+}
+
+/// Whether `message` is a synchronization hazard that validation layers before 1.3.268 report for every element of
+/// a runtime descriptor array the pipeline declares, accessed or not (Vulkan-ValidationLayers issue 3450): every
+/// dispatch and draw that binds the bindless set would "write" every patch texture. Later layers skip runtime
+/// arrays in synchronization validation altogether (pull request 6605), so waiving them checks what they check.
+fn is_runtime_array_hazard(message: &str) -> bool {
+    message.contains("SYNC-HAZARD") && message.contains(&format!("[{}]", super::bindless::SET_NAME))
 }
 
 /// The device and everything needed to use it. Shared by reference; internally synchronised.
@@ -125,14 +140,25 @@ fn create_instance(
     } else {
         vec![]
     };
+    let sync_validation = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features =
+        vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync_validation);
+    // The layer provides VK_EXT_validation_features, through which synchronization validation is enabled.
+    let sync = validation && options.synchronization_validation;
+    if sync {
+        ext_names.push(ext::validation_features::NAME.as_ptr());
+    }
     let app = vk::ApplicationInfo::default()
         .application_name(c"riverplanet")
         .engine_name(c"riverplanet")
         .api_version(vk::API_VERSION_1_3);
-    let info = vk::InstanceCreateInfo::default()
+    let mut info = vk::InstanceCreateInfo::default()
         .application_info(&app)
         .enabled_extension_names(&ext_names)
         .enabled_layer_names(&layer_names);
+    if sync {
+        info = info.push_next(&mut features);
+    }
     // SAFETY: every pointer in `info` outlives the call.
     let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
     Ok((instance, validation && has_debug_utils))
@@ -151,10 +177,19 @@ unsafe extern "system" fn debug_callback(
             .and_then(|d| unsafe { d.message_as_c_str() })
             .map(|m| m.to_string_lossy().into_owned())
             .unwrap_or_default();
+        // SAFETY: `user` is the boxed ValidationLog owned by the Context, alive until the messenger is destroyed.
+        let validation_log = unsafe { (user as *const ValidationLog).as_ref() };
         if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+            if is_runtime_array_hazard(&message) {
+                log::debug!("[vulkan {kind:?}] waived (runtime descriptor array): {message}");
+                if let Some(log) = validation_log {
+                    log.waived
+                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                }
+                return;
+            }
             log::error!("[vulkan {kind:?}] {message}");
-            // SAFETY: `user` is the boxed ValidationLog owned by the Context, alive until the messenger is destroyed.
-            if let Some(log) = unsafe { (user as *const ValidationLog).as_ref() } {
+            if let Some(log) = validation_log {
                 if let Ok(mut errors) = log.errors.lock() {
                     errors.push(message);
                 }
@@ -440,6 +475,14 @@ impl Context {
     /// Whether the validation layer is active (and its errors are being collected).
     pub fn validation_enabled(&self) -> bool {
         self.validation_enabled
+    }
+
+    /// Synchronization hazards waived so far because they were reported through the bindless set's runtime arrays
+    /// (`is_runtime_array_hazard`).
+    pub fn waived_validation_messages(&self) -> usize {
+        self.validation_log
+            .waived
+            .load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Validation errors reported so far. GPU tests assert this is empty.

@@ -2,13 +2,14 @@
 //!
 //! One file per concern, as in wgpu-hal: [`context`] (instance, device choice, device, queue, allocator),
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
-//! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`bindless`] (the global
-//! descriptor-indexed set), [`pipeline`] (shader modules and pipelines), [`profiler`] (timestamp scopes),
-//! [`swapchain`] (window presentation).
+//! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`frames`] (the ring of
+//! frame contexts that keeps frames in flight), [`bindless`] (the global descriptor-indexed set), [`pipeline`]
+//! (shader modules and pipelines), [`profiler`] (timestamp scopes), [`swapchain`] (window presentation).
 
 pub mod bindless;
 pub mod context;
 pub mod features;
+pub mod frames;
 pub mod memory;
 pub mod pipeline;
 pub mod profiler;

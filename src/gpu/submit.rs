@@ -55,46 +55,98 @@ pub struct Recorder<'a> {
     pub cmd: vk::CommandBuffer,
     /// Buffers this recording uses and frees once its submission completed (staging, per-dispatch inputs).
     owned: Vec<Buffer>,
-    /// Transient pool for per-dispatch descriptor sets, retired with the submission.
+    /// Transient pool for per-dispatch descriptor sets.
     descriptor_pool: Option<vk::DescriptorPool>,
+    /// Whether the pools belong to a frame context that resets and reuses them (`gpu::frames`); otherwise they
+    /// belong to this recording and are retired with its submission.
+    pooled: bool,
 }
 
 /// Per-dispatch descriptor sets one recording can allocate.
 const TRANSIENT_SETS: u32 = 64;
 
+/// A pool for the per-dispatch storage-buffer descriptor sets of one recording.
+pub(crate) fn transient_descriptor_pool(ctx: &Context) -> Result<vk::DescriptorPool, GpuError> {
+    let sizes = [vk::DescriptorPoolSize {
+        ty: vk::DescriptorType::STORAGE_BUFFER,
+        descriptor_count: TRANSIENT_SETS * 4,
+    }];
+    let info = vk::DescriptorPoolCreateInfo::default()
+        .max_sets(TRANSIENT_SETS)
+        .pool_sizes(&sizes);
+    // SAFETY: valid create info; the owner retires or resets it after the submission.
+    unsafe { ctx.device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")
+}
+
+/// A command pool for one-time command buffers on the queue's family.
+pub(crate) fn transient_command_pool(ctx: &Context) -> Result<vk::CommandPool, GpuError> {
+    let pool_info = vk::CommandPoolCreateInfo::default()
+        .queue_family_index(ctx.queue_family)
+        .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+    // SAFETY: valid create info; the owner retires or resets it after the submission.
+    unsafe { ctx.device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")
+}
+
+/// One primary command buffer from `pool`.
+pub(crate) fn allocate_command_buffer(
+    ctx: &Context,
+    pool: vk::CommandPool,
+) -> Result<vk::CommandBuffer, GpuError> {
+    let alloc = vk::CommandBufferAllocateInfo::default()
+        .command_pool(pool)
+        .level(vk::CommandBufferLevel::PRIMARY)
+        .command_buffer_count(1);
+    // SAFETY: valid allocate info.
+    Ok(unsafe { ctx.device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0])
+}
+
 impl<'a> Recorder<'a> {
-    /// Starts recording a one-time command buffer named `name`.
+    /// Starts recording a one-time command buffer named `name` in a pool of its own.
     pub fn begin(ctx: &'a Context, name: &str) -> Result<Self, GpuError> {
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(ctx.queue_family)
-            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
-        // SAFETY: valid create info; the pool is retired after the submission.
-        let pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
-            .vk("vkCreateCommandPool")?;
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        let cmd = match unsafe { ctx.device.allocate_command_buffers(&alloc) } {
-            Ok(c) => c[0],
+        let pool = transient_command_pool(ctx)?;
+        let cmd = match allocate_command_buffer(ctx, pool) {
+            Ok(cmd) => cmd,
             Err(e) => {
+                // SAFETY: the pool is unused.
                 unsafe { ctx.device.destroy_command_pool(pool, None) };
-                return Err(GpuError::Vk {
-                    call: "vkAllocateCommandBuffers",
-                    result: e,
-                });
+                return Err(e);
             }
         };
+        Self::start(ctx, name, pool, cmd, None, false)
+    }
+
+    /// Starts recording into a frame context's command buffer `cmd` of `pool` (both reset by the caller), with
+    /// its descriptor pool; the pools are kept after the submission.
+    pub(crate) fn begin_pooled(
+        ctx: &'a Context,
+        name: &str,
+        pool: vk::CommandPool,
+        cmd: vk::CommandBuffer,
+        descriptor_pool: vk::DescriptorPool,
+    ) -> Result<Self, GpuError> {
+        Self::start(ctx, name, pool, cmd, Some(descriptor_pool), true)
+    }
+
+    fn start(
+        ctx: &'a Context,
+        name: &str,
+        pool: vk::CommandPool,
+        cmd: vk::CommandBuffer,
+        descriptor_pool: Option<vk::DescriptorPool>,
+        pooled: bool,
+    ) -> Result<Self, GpuError> {
         ctx.set_name(cmd, name);
         let begin = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: the command buffer is in the initial state (fresh or its pool reset).
         unsafe { ctx.device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
         Ok(Self {
             ctx,
             pool,
             cmd,
             owned: Vec::new(),
-            descriptor_pool: None,
+            descriptor_pool,
+            pooled,
         })
     }
 
@@ -137,20 +189,9 @@ impl<'a> Recorder<'a> {
         let device = &self.ctx.device;
         let pool = match self.descriptor_pool {
             Some(p) => p,
-            None => {
-                let sizes = [vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::STORAGE_BUFFER,
-                    descriptor_count: TRANSIENT_SETS * 4,
-                }];
-                let info = vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(TRANSIENT_SETS)
-                    .pool_sizes(&sizes);
-                // SAFETY: valid create info; retired with the submission.
-                let p = unsafe { device.create_descriptor_pool(&info, None) }
-                    .vk("vkCreateDescriptorPool")?;
-                self.descriptor_pool = Some(p);
-                p
-            }
+            None => *self
+                .descriptor_pool
+                .insert(transient_descriptor_pool(self.ctx)?),
         };
         let layouts = [layout.layout];
         let alloc = vk::DescriptorSetAllocateInfo::default()
@@ -457,9 +498,11 @@ impl<'a> Recorder<'a> {
             .last
             .store(value, std::sync::atomic::Ordering::Release);
         drop(queue);
-        ctx.retire_command_pool(self.pool);
-        if let Some(pool) = self.descriptor_pool {
-            ctx.retire_descriptor_pool(pool);
+        if !self.pooled {
+            ctx.retire_command_pool(self.pool);
+            if let Some(pool) = self.descriptor_pool {
+                ctx.retire_descriptor_pool(pool);
+            }
         }
         for buffer in self.owned {
             ctx.retire_buffer(buffer);

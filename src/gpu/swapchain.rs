@@ -64,7 +64,10 @@ pub struct Swapchain {
     pub views: Vec<vk::ImageView>,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
-    acquired: vk::Semaphore,
+    /// Acquire semaphores, used in turn: one more than the most frames in flight, so the one acquired next is never
+    /// still awaited by a queued frame.
+    acquired: Vec<vk::Semaphore>,
+    next_acquired: usize,
     rendered: Vec<vk::Semaphore>,
 }
 
@@ -152,7 +155,9 @@ impl Swapchain {
             ctx.device
                 .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
         };
-        let acquired = semaphore().vk("vkCreateSemaphore")?;
+        let acquired = (0..=super::frames::MAX_FRAMES_IN_FLIGHT)
+            .map(|_| semaphore().vk("vkCreateSemaphore"))
+            .collect::<Result<_, _>>()?;
         let rendered = (0..images.len())
             .map(|_| semaphore().vk("vkCreateSemaphore"))
             .collect::<Result<_, _>>()?;
@@ -164,19 +169,23 @@ impl Swapchain {
             format: format.format,
             extent,
             acquired,
+            next_acquired: 0,
             rendered,
         })
     }
 
     /// The next image: (index, semaphore signalled when it is ready, semaphore to signal when rendered), or `None`
     /// when the swapchain must be recreated.
-    pub fn acquire(&self) -> Result<Option<(u32, vk::Semaphore, vk::Semaphore)>, GpuError> {
-        // SAFETY: the semaphore is unsignalled (the previous frame using it completed).
+    pub fn acquire(&mut self) -> Result<Option<(u32, vk::Semaphore, vk::Semaphore)>, GpuError> {
+        let acquired = self.acquired[self.next_acquired];
+        self.next_acquired = (self.next_acquired + 1) % self.acquired.len();
+        // SAFETY: the semaphore is unsignalled: the frame that waited on it is more frames back than a frame ring
+        // holds, and the ring has waited for it.
         match unsafe {
             self.loader
-                .acquire_next_image(self.raw, u64::MAX, self.acquired, vk::Fence::null())
+                .acquire_next_image(self.raw, u64::MAX, acquired, vk::Fence::null())
         } {
-            Ok((index, false)) => Ok(Some((index, self.acquired, self.rendered[index as usize]))),
+            Ok((index, false)) => Ok(Some((index, acquired, self.rendered[index as usize]))),
             Ok((_, true)) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => Ok(None),
             Err(result) => Err(GpuError::Vk {
                 call: "vkAcquireNextImageKHR",
@@ -213,7 +222,9 @@ impl Swapchain {
             for v in self.views {
                 ctx.device.destroy_image_view(v, None);
             }
-            ctx.device.destroy_semaphore(self.acquired, None);
+            for s in self.acquired {
+                ctx.device.destroy_semaphore(s, None);
+            }
             for s in self.rendered {
                 ctx.device.destroy_semaphore(s, None);
             }

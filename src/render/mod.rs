@@ -7,4 +7,4 @@ pub mod presets;
 pub mod target;
 pub mod viewer;
 
-pub use frame::{DrawnVertex, FrameStats, Renderer, VertexCapture, ViewMode, WaterMode};
+pub use frame::{DrawnVertex, FrameStats, GpuTimes, Renderer, VertexCapture, ViewMode, WaterMode};

@@ -288,7 +288,7 @@ impl App<'_> {
         }; // minimised
         let camera = self.camera(extent.width, extent.height);
         let (Some(swapchain), Some(depth), Some(renderer)) =
-            (&self.swapchain, &self.depth, &mut self.renderer)
+            (&mut self.swapchain, &self.depth, &mut self.renderer)
         else {
             return Ok(());
         };

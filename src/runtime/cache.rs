@@ -189,10 +189,10 @@ impl PatchCache {
 }
 
 fn release(ctx: &Context, bindless: &mut Bindless, data: PatchData) {
-    bindless.release(data.base_slot);
+    bindless.release(ctx, data.base_slot);
     ctx.retire_image(data.base);
     if let Some((image, slot)) = data.river {
-        bindless.release(slot);
+        bindless.release(ctx, slot);
         ctx.retire_image(image);
     }
 }

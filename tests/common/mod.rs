@@ -19,10 +19,24 @@ static CONTEXT: OnceLock<Result<Context, String>> = OnceLock::new();
 
 /// The shared context, or `None` (test skipped) when no usable device exists and a GPU is not required.
 pub fn gpu() -> Option<&'static Context> {
-    let result = CONTEXT.get_or_init(|| {
+    shared(&CONTEXT, false)
+}
+
+/// As `gpu`, with synchronization validation on as well (use in a test binary of its own: it is slow).
+pub fn gpu_with_synchronization_validation() -> Option<&'static Context> {
+    static SYNC: OnceLock<Result<Context, String>> = OnceLock::new();
+    shared(&SYNC, true)
+}
+
+fn shared(
+    cell: &'static OnceLock<Result<Context, String>>,
+    synchronization: bool,
+) -> Option<&'static Context> {
+    let result = cell.get_or_init(|| {
         let _ = env_logger::builder().is_test(true).try_init();
         let mut options = ContextOptions::from_env();
         options.validation = std::env::var("RIVERPLANET_VALIDATION").map_or(true, |v| v != "0");
+        options.synchronization_validation |= synchronization && options.validation;
         Context::new(&options).map_err(|e| e.to_string())
     });
     let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");

@@ -67,7 +67,7 @@ impl BatchOutputs {
             grid_size,
         };
         for k in 0..patches {
-            let Some(slot) = bindless.allocate() else {
+            let Some(slot) = bindless.allocate(ctx) else {
                 let capacity = bindless.capacity;
                 outputs.destroy(ctx, bindless);
                 return Err(GpuError::Invalid(format!(
@@ -101,7 +101,7 @@ impl BatchOutputs {
     /// Frees the textures (after the GPU is done with them) and their slots.
     pub fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
         for s in self.slots {
-            bindless.release(s);
+            bindless.release(ctx, s);
         }
         for i in self.images {
             ctx.retire_image(i);

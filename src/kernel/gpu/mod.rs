@@ -246,9 +246,10 @@ impl RiverKernel {
         let set = rec.buffer_set(&self.tiled_inputs, &[samples, table_buffer, &masks]);
         if let Ok(set) = set {
             rec.fill_buffer(&masks, 0);
+            // ALL_TRANSFER: the spec puts fills in the CLEAR stage, older validation layers in COPY.
             rec.buffer_barrier(
                 &masks,
-                vk::PipelineStageFlags2::CLEAR,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
                 vk::AccessFlags2::TRANSFER_WRITE,
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,

@@ -255,9 +255,10 @@ impl Renderer<'_> {
                 location: MemoryLocation::GpuToCpu,
             })?;
             rec.fill_buffer(&buffer, 0);
+            // ALL_TRANSFER: the spec puts fills in the CLEAR stage, older validation layers in COPY.
             rec.buffer_barrier(
                 &buffer,
-                vk::PipelineStageFlags2::CLEAR,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
                 vk::AccessFlags2::TRANSFER_WRITE,
                 vk::PipelineStageFlags2::VERTEX_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_WRITE,
@@ -312,9 +313,10 @@ impl Renderer<'_> {
             vk::ImageAspectFlags::COLOR,
             color_layouts.0,
             vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            // After the previous frame's writes to the same target, which may still be in flight.
             (
                 vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                vk::AccessFlags2::NONE,
+                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
             ),
             (
                 vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
@@ -340,7 +342,7 @@ impl Renderer<'_> {
         rec.begin_rendering(target, true);
         let sets = [self.bindless.set, instance_set];
         let push = bytemuck::bytes_of(&push);
-        let scope = self.profiler.begin(rec, "terrain")?;
+        let scope = self.frames.profiler().begin(rec, "terrain")?;
         let terrain = if self.wireframe_on {
             &self.wireframe
         } else {
@@ -356,8 +358,8 @@ impl Renderer<'_> {
                 instances.clone(),
             );
         }
-        self.profiler.end(rec, scope);
-        let scope = self.profiler.begin(rec, "water")?;
+        self.frames.profiler().end(rec, scope);
+        let scope = self.frames.profiler().begin(rec, "water")?;
         if !self.wireframe_on {
             rec.draw_indexed(
                 &self.water,
@@ -368,7 +370,7 @@ impl Renderer<'_> {
                 water_instances,
             );
         }
-        self.profiler.end(rec, scope);
+        self.frames.profiler().end(rec, scope);
         rec.end_rendering();
         if color_layouts.1 != vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL {
             rec.raw_image_transition(

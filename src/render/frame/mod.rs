@@ -18,8 +18,9 @@ use crate::{
     config::Config,
     gpu::{
         bindless::{Bindless, Slot},
+        frames::{Finished, FrameRing, FRAMES_IN_FLIGHT},
         pipeline::{BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
-        vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Profiler, Recorder,
+        vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
     },
     kernel::{
         gpu::{KernelTuning, KernelVariant, RiverKernel},
@@ -95,7 +96,15 @@ pub struct FrameStats {
     pub precomputed_height_bytes: u64,
     pub memory_bytes: u64,
     pub cpu_ms: BTreeMap<String, f64>,
+    /// GPU time per pass of frame `gpu_frame`: the latest that finished by the end of this call, one or two
+    /// frames before this one (frames in flight); empty until the first has finished.
     pub gpu_ms: BTreeMap<String, f64>,
+    pub gpu_frame: u64,
+    /// Frames submitted and not yet finished on the GPU when this call returned (this one included).
+    pub frames_in_flight: usize,
+    /// The newest frame the CPU had waited for (or seen finished) before submitting this one: with two frames in
+    /// flight, the frame two back, so the previous frame was still queued while this one was recorded.
+    pub synchronized_frame: u64,
     pub frame_ms: f64,
 }
 
@@ -110,6 +119,25 @@ impl FrameStats {
     pub fn streamed(&self) -> bool {
         self.pending_patches == 0 && self.fallback_patches == 0 && self.new_patches == 0
     }
+}
+
+/// Timestamp scopes per frame: heights, kernel, terrain, water, with room to spare.
+const TIMESTAMP_SCOPES: u32 = 8;
+
+/// What a frame in flight leaves to read back once the GPU has finished it.
+struct InFlight {
+    frame: u64,
+    new_patches: usize,
+    ranges: Option<crate::refine::RefinedRanges>,
+    drawn: draw::Drawn,
+    camera: DVec3,
+}
+
+/// The GPU time per pass of one finished frame.
+#[derive(Clone, Debug)]
+pub struct GpuTimes {
+    pub frame: u64,
+    pub ms: BTreeMap<String, f64>,
 }
 
 fn ms_since(t: Instant) -> f64 {
@@ -135,7 +163,11 @@ pub struct Renderer<'w> {
     quadrant_ranges: [std::ops::Range<u32>; 4],
     all_indices: std::ops::Range<u32>,
     cache: PatchCache,
-    profiler: Profiler,
+    frames: FrameRing<InFlight>,
+    /// GPU times of finished frames not yet taken (`take_gpu_times`).
+    gpu_times: Vec<GpuTimes>,
+    /// The newest frame collected after the GPU finished it.
+    synchronized_frame: u64,
     params: KernelParams,
     heights: HeightRange,
     frame: u64,
@@ -232,7 +264,7 @@ impl<'w> Renderer<'w> {
         ctx.run_and_wait("upload patch mesh", |rec| {
             rec.upload_buffer(&indices, 0, bytemuck::cast_slice(&mesh))
         })?;
-        let profiler = Profiler::new(ctx, 8, "frame timestamps")?;
+        let frames = FrameRing::new(ctx, FRAMES_IN_FLIGHT, TIMESTAMP_SCOPES, "frame")?;
         // Culling bounds: every height any level can reach (finer levels add at most a bound to the precomputed
         // range), with a river basin's depth and a unit of margin either way.
         let (lowest, highest) = planet.height_bounds();
@@ -258,7 +290,9 @@ impl<'w> Renderer<'w> {
             quadrant_ranges: quadrants,
             all_indices: 0..mesh.len() as u32,
             cache: PatchCache::new(capacity),
-            profiler,
+            frames,
+            gpu_times: Vec::new(),
+            synchronized_frame: 0,
             params: KernelParams::from_config(config),
             heights,
             frame: 0,
@@ -302,13 +336,22 @@ impl<'w> Renderer<'w> {
             *layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
             frames += 1;
             if stats.streamed() || frames >= max_frames {
+                let mut stats = stats;
+                self.finish()?;
+                if let Some(last) = self.gpu_times.last() {
+                    stats.gpu_ms = last.ms.clone();
+                    stats.gpu_frame = last.frame;
+                }
+                stats.frames_in_flight = 0;
                 return Ok((stats, frames));
             }
         }
     }
 
     /// Renders one frame into `target`, whose colour image is in `color_layouts.0` and is left in
-    /// `color_layouts.1`. `waits` and `signals` are binary semaphores (swapchain). Blocks until the frame is done.
+    /// `color_layouts.1`. `waits` and `signals` are binary semaphores (swapchain). Does not wait for this frame:
+    /// it waits only for the frame that last used the same frame context (`FRAMES_IN_FLIGHT` back), and collects
+    /// what finished frames left (height ranges, vertex capture, GPU times). `finish` waits for all of them.
     pub fn render(
         &mut self,
         camera: &Camera,
@@ -326,7 +369,6 @@ impl<'w> Renderer<'w> {
             ..Default::default()
         };
         let mut cpu = BTreeMap::new();
-        let n = self.config.rendering.vertices;
 
         let visible = self.visible_patches(camera, &mut stats, &mut cpu);
         let plan = self.plan_streaming(camera, &visible, &mut stats)?;
@@ -337,8 +379,11 @@ impl<'w> Renderer<'w> {
         stats.samples = prepared.iter().map(|p| p.samples.len()).sum();
 
         let t = Instant::now();
-        let mut rec = Recorder::begin(ctx, "frame")?;
-        self.profiler.reset(ctx);
+        let (mut rec, finished) = self.frames.begin(ctx, "frame")?;
+        cpu.insert("frame wait".to_string(), ms_since(t));
+        self.collect(finished.into_iter().collect())?;
+
+        let t = Instant::now();
         let uploaded = self.upload_new_patches(&mut rec, &prepared)?;
         stats.temporary_sample_bytes = uploaded.bytes;
         stats.river_patches = uploaded.river_patches;
@@ -353,19 +398,21 @@ impl<'w> Renderer<'w> {
         cpu.insert("record".to_string(), ms_since(t));
 
         let t = Instant::now();
-        let id = rec.submit_with(waits, signals)?;
-        ctx.wait(id)?;
-        cpu.insert("gpu wait".to_string(), ms_since(t));
-        self.last_capture = drawn.read_capture(ctx, camera.position, n);
-        if let Some(ranges) = uploaded.ranges {
-            for (patch, range) in ranges.read(ctx)? {
-                self.cache.set_height_range(&patch, range);
-            }
+        let in_flight = InFlight {
+            frame: self.frame,
+            new_patches: stats.new_patches,
+            ranges: uploaded.ranges,
+            drawn,
+            camera: camera.position,
+        };
+        stats.synchronized_frame = self.synchronized_frame;
+        self.frames.submit(rec, waits, signals, in_flight)?;
+        cpu.insert("submit".to_string(), ms_since(t));
+        stats.frames_in_flight = self.frames.in_flight(ctx)?;
+        if let Some(last) = self.gpu_times.last() {
+            stats.gpu_ms = last.ms.clone();
+            stats.gpu_frame = last.frame;
         }
-        for scope in self.profiler.read(ctx)? {
-            *stats.gpu_ms.entry(scope.name).or_default() += scope.ms;
-        }
-        self.measure_generation(&stats);
         stats.resident_patches = self.cache.len();
         stats.patch_texture_bytes = self.cache.bytes();
         stats.precomputed_height_bytes = self.planet.lattice.bytes();
@@ -388,19 +435,88 @@ impl<'w> Renderer<'w> {
         Ok(stats)
     }
 
-    /// A free bindless slot, evicting the least recently used patches if none is left.
+    /// A free bindless slot, evicting the least recently used patches if none is left, and waiting for the frames
+    /// in flight when the evicted slots are still theirs (only when the cache is full).
     fn slot(&mut self) -> Result<Slot, GpuError> {
-        if let Some(s) = self.bindless.allocate() {
+        let ctx = self.ctx;
+        if let Some(s) = self.bindless.allocate(ctx) {
             return Ok(s);
         }
         let capacity = self.cache.capacity;
-        self.cache.evict_to(capacity, self.ctx, &mut self.bindless);
-        self.bindless.allocate().ok_or_else(|| {
+        self.cache.evict_to(capacity, ctx, &mut self.bindless);
+        if let Some(s) = self.bindless.allocate(ctx) {
+            return Ok(s);
+        }
+        if self.bindless.pending_release() > 0 {
+            let finished = self.frames.drain(ctx)?;
+            self.collect(finished)?;
+        }
+        self.bindless.allocate(ctx).ok_or_else(|| {
             GpuError::Invalid(format!(
                 "all {} bindless slots are in use; raise max-resident-patches or lower new-patches-per-frame",
                 self.bindless.capacity
             ))
         })
+    }
+
+    /// Sets how many frames may be in flight (1 to 3; 1 waits for every frame before the next, as the thesis's
+    /// renderer did). Waits for the frames in flight first.
+    pub fn set_frames_in_flight(&mut self, count: usize) -> Result<(), GpuError> {
+        self.finish()?;
+        let ring = FrameRing::new(self.ctx, count, TIMESTAMP_SCOPES, "frame")?;
+        std::mem::replace(&mut self.frames, ring).destroy(self.ctx);
+        Ok(())
+    }
+
+    /// How many frames may be in flight.
+    pub fn frames_in_flight(&self) -> usize {
+        self.frames.contexts()
+    }
+
+    /// Waits for every frame in flight and collects what they left: afterwards `last_capture`, the height ranges
+    /// and `take_gpu_times` hold everything rendered so far.
+    pub fn finish(&mut self) -> Result<(), GpuError> {
+        let finished = self.frames.drain(self.ctx)?;
+        self.collect(finished)
+    }
+
+    /// The GPU times of the frames finished since the last call, oldest first.
+    pub fn take_gpu_times(&mut self) -> Vec<GpuTimes> {
+        std::mem::take(&mut self.gpu_times)
+    }
+
+    /// Takes in what finished frames left: refined patches' height ranges (for culling), the vertex capture, and
+    /// GPU times (which also steer the generation budget).
+    fn collect(&mut self, finished: Vec<Finished<InFlight>>) -> Result<(), GpuError> {
+        let n = self.config.rendering.vertices;
+        for Finished {
+            timings, payload, ..
+        } in finished
+        {
+            if let Some(ranges) = payload.ranges {
+                for (patch, range) in ranges.read(self.ctx)? {
+                    self.cache.set_height_range(&patch, range);
+                }
+            }
+            if let Some(capture) = payload.drawn.read_capture(self.ctx, payload.camera, n) {
+                self.last_capture = Some(capture);
+            }
+            let mut ms = BTreeMap::new();
+            for scope in timings {
+                *ms.entry(scope.name).or_default() += scope.ms;
+            }
+            self.measure_generation(payload.new_patches, &ms);
+            self.synchronized_frame = self.synchronized_frame.max(payload.frame);
+            // Keep a bounded backlog for callers that never take them (the viewer reads FrameStats instead).
+            if self.gpu_times.len() >= 1024 {
+                self.gpu_times.remove(0);
+            }
+            self.gpu_times.push(GpuTimes {
+                frame: payload.frame,
+                ms,
+            });
+        }
+        Ok(())
     }
 
     /// Frees every GPU object of the renderer (after the device is idle).
@@ -409,7 +525,7 @@ impl<'w> Renderer<'w> {
         let _ = ctx.wait_idle();
         self.cache.clear(ctx, &mut self.bindless);
         ctx.retire_buffer(self.indices);
-        self.profiler.destroy(ctx);
+        self.frames.destroy(ctx);
         self.kernel.destroy(ctx);
         self.refiner.destroy(ctx);
         self.terrain.destroy(ctx);

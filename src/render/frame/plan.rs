@@ -88,15 +88,19 @@ impl Renderer<'_> {
     }
 
     /// Folds a frame's GPU time for making patches into the average per patch (exponential, a quarter per frame).
-    pub(super) fn measure_generation(&mut self, stats: &FrameStats) {
-        if stats.new_patches == 0 {
+    pub(super) fn measure_generation(
+        &mut self,
+        new_patches: usize,
+        gpu_ms: &BTreeMap<String, f64>,
+    ) {
+        if new_patches == 0 {
             return;
         }
         let ms: f64 = ["heights", "kernel"]
             .iter()
-            .filter_map(|scope| stats.gpu_ms.get(*scope))
+            .filter_map(|scope| gpu_ms.get(*scope))
             .sum();
-        let sample = ms / stats.new_patches as f64;
+        let sample = ms / new_patches as f64;
         self.generation_ms_per_patch = Some(match self.generation_ms_per_patch {
             Some(average) => 0.75 * average + 0.25 * sample,
             None => sample,

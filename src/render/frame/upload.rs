@@ -150,11 +150,11 @@ impl Renderer<'_> {
         let mut bytes = 0;
         let mut ranges = None;
         if !jobs.is_empty() {
-            let scope = self.profiler.begin(rec, "heights")?;
+            let scope = self.frames.profiler().begin(rec, "heights")?;
             ranges = self
                 .refiner
                 .record(rec, &self.bindless, self.planet, &jobs)?;
-            self.profiler.end(rec, scope);
+            self.frames.profiler().end(rec, scope);
             bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
         rec.memory_barrier(
@@ -196,11 +196,11 @@ impl Renderer<'_> {
                 jobs: &patch_jobs,
                 parents: &parents,
             };
-            let scope = self.profiler.begin(rec, "kernel")?;
+            let scope = self.frames.profiler().begin(rec, "kernel")?;
             bytes += self
                 .kernel
                 .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
-            self.profiler.end(rec, scope);
+            self.frames.profiler().end(rec, scope);
             rec.memory_barrier(
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_WRITE,
