@@ -109,12 +109,25 @@ pub struct RiverConfig {
     pub samples_per_vertex_spacing: u32,
 }
 
+/// How the level of detail picks a patch's level (6.2.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LodRule {
+    /// Beyond the thesis: refine while a patch's geometric error would cover more than `pixel-error` pixels.
+    ScreenSpaceError,
+    /// The thesis's Eq. 6.1: refine while nearer than radius x switch factor / 2^level.
+    Distance,
+}
+
 /// `<rendering-attributes>`: Table 6.1 plus the run-time budgets.
 #[derive(Clone, Debug, Serialize)]
 pub struct RenderingConfig {
     pub vertices: u32,
     pub max_level_of_detail: u32,
     pub level_of_detail_switch_factor: f32,
+    pub level_of_detail_rule: LodRule,
+    /// Screen-space-error rule: the geometric error, in pixels, a patch may show before it is refined.
+    pub pixel_error: f32,
     /// Patch textures resident at once (bindless slots); least recently used are evicted beyond it.
     pub max_resident_patches: u32,
     /// New patches generated per frame at most; the rest draw their parent until their data arrives.
@@ -134,13 +147,15 @@ pub struct Config {
 }
 
 impl Config {
-    /// The defaults of `model`: Appendix A's values for the thesis's model (`appendix_a`); for the drainage model
-    /// the values config/planet.xml was tuned with (docs/rivers.md): a river where 700 square units drain, a quarter
-    /// of the diamond-square detail (the relief carries the shape), and at most four samples per vertex spacing (a
-    /// thousand rivers would give coarse patches millions of samples).
+    /// The defaults of a file with `model`: Appendix A's values (`appendix_a`) with the screen-space-error level of
+    /// detail (the product's rule; `<level-of-detail-rule>distance</level-of-detail-rule>` selects Eq. 6.1), and
+    /// for the drainage model the values config/planet.xml was tuned with (docs/rivers.md): a river where 700
+    /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), and at most four
+    /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples).
     pub fn defaults_for(model: RiverModel) -> Self {
         let mut d = Self::appendix_a();
         d.river.model = model;
+        d.rendering.level_of_detail_rule = LodRule::ScreenSpaceError;
         if model == RiverModel::Drainage {
             d.planet.detail_amplitude = 2.0;
             d.river.source_area = 700.0;
@@ -149,8 +164,8 @@ impl Config {
         d
     }
 
-    /// The values of Appendix A with the thesis's river model (and `master-seed` 1 instead of -1 so the planet is
-    /// reproducible): the planet of the thesis's Chapter 9 experiments.
+    /// The values of Appendix A with the thesis's river model and level of detail (Eq. 6.1), and `master-seed` 1
+    /// instead of -1 so the planet is reproducible: the planet of the thesis's Chapter 9 experiments.
     pub fn appendix_a() -> Self {
         Self {
             planet: PlanetConfig {
@@ -193,6 +208,8 @@ impl Config {
                 vertices: 33,
                 max_level_of_detail: 6,
                 level_of_detail_switch_factor: 8.0,
+                level_of_detail_rule: LodRule::Distance,
+                pixel_error: 2.0,
                 max_resident_patches: 2048,
                 new_patches_per_frame: 64,
                 generation_budget_ms: 8.0,
@@ -270,6 +287,8 @@ struct RawRendering {
     #[serde(alias = "mas-level-of-detail")]
     max_level_of_detail: Option<String>,
     level_of_detail_switch_factor: Option<String>,
+    level_of_detail_rule: Option<String>,
+    pixel_error: Option<String>,
     max_resident_patches: Option<String>,
     new_patches_per_frame: Option<String>,
     generation_budget_ms: Option<String>,
@@ -684,6 +703,21 @@ impl Config {
                 "level-of-detail-switch-factor",
                 &g.level_of_detail_switch_factor,
                 dg.level_of_detail_switch_factor,
+                Range::Positive,
+            )?,
+            level_of_detail_rule: r.choice(
+                "level-of-detail-rule",
+                &g.level_of_detail_rule,
+                dg.level_of_detail_rule,
+                &[
+                    ("screen-space-error", LodRule::ScreenSpaceError),
+                    ("distance", LodRule::Distance),
+                ],
+            )?,
+            pixel_error: r.f32(
+                "pixel-error",
+                &g.pixel_error,
+                dg.pixel_error,
                 Range::Positive,
             )?,
             max_resident_patches: r.u32(

@@ -1,6 +1,6 @@
 //! The XML configuration: Appendix A as printed, and every class of bad input reported by element and range.
 
-use riverplanet::config::{Config, ConfigError, RiverModel};
+use riverplanet::config::{Config, ConfigError, LodRule, RiverModel};
 
 const APPENDIX_A: &str = include_str!("../config/thesis.xml");
 
@@ -52,17 +52,46 @@ fn appendix_a_reads_as_printed() {
 #[test]
 fn the_shipped_files_load_from_disk_with_their_models() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
-    for (file, model) in [
-        ("planet.xml", RiverModel::Drainage),
-        ("thesis.xml", RiverModel::Thesis),
-        ("earth.xml", RiverModel::Thesis),
+    for (file, model, rule) in [
+        (
+            "planet.xml",
+            RiverModel::Drainage,
+            LodRule::ScreenSpaceError,
+        ),
+        ("thesis.xml", RiverModel::Thesis, LodRule::Distance),
+        ("earth.xml", RiverModel::Thesis, LodRule::Distance),
     ] {
-        assert_eq!(
-            Config::load(&dir.join(file)).unwrap().river.model,
-            model,
-            "{file}"
-        );
+        let c = Config::load(&dir.join(file)).unwrap();
+        assert_eq!(c.river.model, model, "{file}");
+        assert_eq!(c.rendering.level_of_detail_rule, rule, "{file}");
     }
+}
+
+#[test]
+fn the_level_of_detail_rule_and_pixel_error_are_named_or_refused() {
+    let c = Config::parse(
+        &with(
+            "rendering-attributes",
+            "level-of-detail-rule",
+            "screen-space-error",
+        ),
+        "t.xml",
+    )
+    .unwrap();
+    assert_eq!(c.rendering.level_of_detail_rule, LodRule::ScreenSpaceError);
+    assert_eq!(c.rendering.pixel_error, 2.0);
+    let message = error_of(&with(
+        "rendering-attributes",
+        "level-of-detail-rule",
+        "near",
+    ));
+    assert!(
+        message.contains("level-of-detail-rule")
+            && message.contains("screen-space-error, distance"),
+        "{message}"
+    );
+    let message = error_of(&with("rendering-attributes", "pixel-error", "0"));
+    assert!(message.contains("<pixel-error>"), "{message}");
 }
 
 #[test]

@@ -16,11 +16,7 @@ use riverplanet::{
 const RADIUS: f64 = 1024.0;
 
 fn params(max_level: u32) -> LodParams {
-    LodParams {
-        radius: RADIUS,
-        switch_factor: 8.0,
-        max_level,
-    }
+    LodParams::distance(RADIUS, 8.0, max_level)
 }
 
 fn random_camera(rng: &mut Rng) -> DVec3 {
@@ -79,6 +75,55 @@ fn lod_selection_equals_brute_force_of_eq_6_1() {
         let fast: BTreeSet<Selected> = select(camera, &p).into_iter().collect();
         assert_eq!(fast, brute_force(camera, &p), "camera {camera}");
     }
+}
+
+/// A geometric error per level that does not halve everywhere (a rough level 2), as a planet's measured errors.
+fn uneven_error(level: u32) -> f64 {
+    let base = 40.0 / (1u64 << level) as f64;
+    if level == 2 {
+        base * 3.0
+    } else {
+        base
+    }
+}
+
+/// Screen-space error: no drawn quadrant (below the deepest level) shows more than the allowed pixels of its
+/// patch's error at the quadrant's nearest distance, and switch distances at least halve per level (patches meet
+/// only patches one level apart).
+#[test]
+fn screen_space_error_selection_never_draws_more_than_the_allowed_pixels() {
+    let (pixels_per_radian, pixels) = (720.0 / (2.0 * (22.5f64).to_radians().tan()), 2.0);
+    let p = LodParams::screen_space(RADIUS, uneven_error, pixels_per_radian, pixels, 7);
+    for level in 1..p.max_level {
+        assert!(
+            p.threshold(level) >= 2.0 * p.threshold(level + 1),
+            "level {level}: {} < 2 x {}",
+            p.threshold(level),
+            p.threshold(level + 1)
+        );
+    }
+    let mut rng = Rng::new(5, &[]);
+    let mut checked = 0;
+    for _ in 0..100 {
+        let camera = random_camera(&mut rng);
+        for s in select(camera, &p) {
+            if s.patch.level as u32 == p.max_level {
+                continue;
+            }
+            for q in (0..4).filter(|q| s.quadrants & (1 << q) != 0) {
+                let quadrant = s.patch.child(q);
+                let distance = camera.distance(quadrant.center() * RADIUS);
+                let shown = uneven_error(s.patch.level as u32) * pixels_per_radian / distance;
+                assert!(
+                    shown <= pixels * (1.0 + 1e-9),
+                    "{:?} quadrant {q} shows {shown:.2} pixels of error at {distance:.1}",
+                    s.patch
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 1000, "only {checked} quadrants checked");
 }
 
 #[test]

@@ -50,9 +50,11 @@ pub struct FlightFrame {
 #[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct FlightSummary {
     pub frames: usize,
-    pub average_frame_ms: f64,
-    pub median_frame_ms: f64,
-    pub max_frame_ms: f64,
+    pub frame_ms_mean: f64,
+    /// Triangles the terrain pass drew per frame, on average.
+    pub triangles_mean: f64,
+    pub frame_ms_median: f64,
+    pub frame_ms_max: f64,
     pub average_fps: f64,
     pub average_visible_patches: f64,
     pub max_visible_patches: usize,
@@ -79,8 +81,6 @@ pub struct FlightSummary {
     /// Largest memory of any frame (patch textures, temporary data, precomputed heights), as `max_memory_bytes`.
     #[serde(default)]
     pub peak_memory_bytes: u64,
-    #[serde(default)]
-    pub frame_ms_median: f64,
     /// Slowest frame after the first [`WARMUP_FRAMES`] (start-up: pipelines, the first patches).
     #[serde(default)]
     pub frame_ms_max_after_warmup: f64,
@@ -110,6 +110,7 @@ pub struct FlightReport {
     pub morphing: bool,
     pub parent_reuse: bool,
     pub frames_in_flight: usize,
+    pub lod_rule: crate::config::LodRule,
     pub river_model: crate::config::RiverModel,
     pub radius: f64,
     pub seed: u32,
@@ -146,6 +147,8 @@ pub struct FlightOptions {
     pub frame_images: Option<std::path::PathBuf>,
     /// Frames the CPU may record ahead of the GPU (1: the thesis's wait for every frame).
     pub frames_in_flight: usize,
+    /// The level-of-detail rule instead of the configuration's.
+    pub lod_rule: Option<crate::config::LodRule>,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -180,6 +183,9 @@ fn fly(
     renderer.morphing = options.morphing;
     renderer.parent_reuse = options.parent_reuse;
     renderer.set_frames_in_flight(options.frames_in_flight)?;
+    if let Some(rule) = options.lod_rule {
+        renderer.lod_rule = rule;
+    }
     renderer.capture_batches = runner.is_some();
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
@@ -302,7 +308,7 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
 fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
     let stats: Vec<&FrameStats> = frames.iter().map(|f| &f.stats).collect();
     let frame_ms: Vec<f64> = stats.iter().map(|s| s.frame_ms).collect();
-    let average_frame_ms = mean(frame_ms.iter().copied());
+    let frame_ms_mean = mean(frame_ms.iter().copied());
     let keys = |f: &dyn Fn(&FrameStats) -> &BTreeMap<String, f64>| {
         let names: std::collections::BTreeSet<&String> =
             stats.iter().flat_map(|s| f(s).keys()).collect();
@@ -355,11 +361,11 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
     let max_memory_bytes = stats.iter().map(|s| s.memory_bytes).max().unwrap_or(0);
     FlightSummary {
         frames: frames.len(),
-        average_frame_ms,
-        median_frame_ms: super::median(&frame_ms),
+        frame_ms_mean,
+        triangles_mean: mean(stats.iter().map(|s| s.terrain_triangles as f64)),
+        frame_ms_median: super::median(&frame_ms),
         deepest_level: stats.iter().map(|s| s.deepest_level).max().unwrap_or(0),
         peak_memory_bytes: max_memory_bytes,
-        frame_ms_median: super::median(&frame_ms),
         frame_ms_max_after_warmup: frame_ms
             .iter()
             .skip(WARMUP_FRAMES)
@@ -368,9 +374,9 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
         max_generated_patches: stats.iter().map(|s| s.new_patches).max().unwrap_or(0),
         hole_checked_frames: frames.iter().filter(|f| f.hole_pixels.is_some()).count(),
         hole_pixels: frames.iter().filter_map(|f| f.hole_pixels).sum(),
-        max_frame_ms: frame_ms.iter().copied().fold(0.0, f64::max),
-        average_fps: if average_frame_ms > 0.0 {
-            1000.0 / average_frame_ms
+        frame_ms_max: frame_ms.iter().copied().fold(0.0, f64::max),
+        average_fps: if frame_ms_mean > 0.0 {
+            1000.0 / frame_ms_mean
         } else {
             0.0
         },
@@ -437,7 +443,7 @@ pub fn flight_bench(
     let mut summary = summarise(&frames, config.rendering.max_resident_patches as usize);
     summary
         .water_mode_frame_ms
-        .insert("auto".into(), summary.average_frame_ms);
+        .insert("auto".into(), summary.frame_ms_mean);
     let mut water_mode_frames = BTreeMap::new();
     if options.compare_water_modes {
         for (name, mode) in [
@@ -463,6 +469,9 @@ pub fn flight_bench(
         morphing: options.morphing,
         parent_reuse: options.parent_reuse,
         frames_in_flight: options.frames_in_flight,
+        lod_rule: options
+            .lod_rule
+            .unwrap_or(config.rendering.level_of_detail_rule),
         river_model: config.river.model,
         radius: world.planet.radius,
         seed: world.seed,

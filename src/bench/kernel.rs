@@ -95,11 +95,11 @@ pub fn flight_workload(world: &World, stress: bool, frames: u32) -> Vec<(f32, Ve
 /// The level-of-detail parameters of `world`, with the switch factor scaled by `switch_scale`.
 pub fn lod_params(world: &World, switch_scale: f64) -> LodParams {
     let rendering = &world.config.rendering;
-    LodParams {
-        radius: world.planet.radius,
-        switch_factor: rendering.level_of_detail_switch_factor as f64 * switch_scale,
-        max_level: rendering.max_level_of_detail,
-    }
+    LodParams::distance(
+        world.planet.radius,
+        rendering.level_of_detail_switch_factor as f64 * switch_scale,
+        rendering.max_level_of_detail,
+    )
 }
 
 /// Every visible patch of `flight`'s first `frames` frames that a river influences, once, in the order the

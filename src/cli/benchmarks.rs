@@ -89,6 +89,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             frame_images,
             no_morphing,
             no_parent_reuse,
+            lod_rule,
             frames_in_flight,
             frames,
             speed,
@@ -127,6 +128,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 frame_images,
                 morphing: !no_morphing,
                 parent_reuse: !no_parent_reuse,
+                lod_rule,
                 frames_in_flight,
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
@@ -152,14 +154,20 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 } else {
                     ""
                 },
-                s.average_frame_ms,
+                s.frame_ms_mean,
                 s.average_fps,
-                s.median_frame_ms,
-                s.max_frame_ms
+                s.frame_ms_median,
+                s.frame_ms_max
             );
             println!(
-                "  patches: {:.1} visible, {:.2} new per frame (max {}); samples {:.0} per frame (max {})",
-                s.average_visible_patches, s.average_new_patches, s.max_new_patches, s.average_samples, s.max_samples
+                "  patches: {:.1} visible, {:.2} new per frame (max {}); samples {:.0} per frame (max {}); \
+                 {:.0} terrain triangles per frame",
+                s.average_visible_patches,
+                s.average_new_patches,
+                s.max_new_patches,
+                s.average_samples,
+                s.max_samples,
+                s.triangles_mean
             );
             println!(
                 "  memory: max {:.1} MB ({:.1} MB patch textures, {} of {} patches resident; {:.2} MB samples)",

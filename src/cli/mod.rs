@@ -9,6 +9,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 use riverplanet::{
+    config::LodRule,
     kernel::gpu::KernelTuning,
     render::{ViewMode, WaterMode},
 };
@@ -135,6 +136,10 @@ pub struct RenderArgs {
     /// selection with morphing.
     #[arg(long)]
     pub no_morphing: bool,
+    /// The level-of-detail rule instead of the configuration's `level-of-detail-rule`: `screen-space-error` or
+    /// `distance` (the thesis's Eq. 6.1).
+    #[arg(long, value_parser = parse_lod_rule)]
+    pub lod_rule: Option<LodRule>,
     #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
     pub clear_color: glam::DVec3,
     /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
@@ -231,6 +236,9 @@ pub enum BenchCommand {
         /// Compute every patch's river data from scratch, as the thesis (no data from the parent, 10.2).
         #[arg(long)]
         no_parent_reuse: bool,
+        /// The level-of-detail rule instead of the configuration's: `screen-space-error` or `distance` (Eq. 6.1).
+        #[arg(long, value_parser = parse_lod_rule)]
+        lod_rule: Option<LodRule>,
         /// Frames the CPU may record ahead of the GPU (1: wait for every frame before the next, as the thesis).
         #[arg(long, default_value_t = riverplanet::gpu::frames::FRAMES_IN_FLIGHT,
               value_parser = clap::builder::RangedU64ValueParser::<usize>::new()
@@ -280,6 +288,16 @@ fn positive_count(text: &str) -> Result<usize, String> {
 }
 
 /// A finite number above 0.
+fn parse_lod_rule(text: &str) -> Result<LodRule, String> {
+    match text {
+        "screen-space-error" => Ok(LodRule::ScreenSpaceError),
+        "distance" => Ok(LodRule::Distance),
+        _ => Err(format!(
+            "'{text}' is not a level-of-detail rule: screen-space-error or distance (the thesis's Eq. 6.1)"
+        )),
+    }
+}
+
 fn positive_number(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),

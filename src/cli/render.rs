@@ -48,6 +48,9 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     renderer.view_mode = args.view;
     renderer.variant = args.kernel;
     renderer.morphing = !args.no_morphing;
+    if let Some(rule) = args.lod_rule {
+        renderer.lod_rule = rule;
+    }
     let altitude = eye.length() - config.planet.radius as f64;
     let camera = riverplanet::runtime::camera::Camera::look_at(
         eye,

@@ -287,6 +287,45 @@ impl FaceLattice {
         levels.reverse();
         levels
     }
+
+    /// Per level 0..`top` (this lattice being level `top` with `n` vertices per patch edge): the largest vertical
+    /// distance between a lattice point and the bilinear surface through the vertices of that level's patches,
+    /// i.e. how far a patch of that level can stand from this lattice (the geometric error of screen-space-error
+    /// level of detail, docs/rendering.md).
+    pub fn level_deviations(&self, top: u32, n: u32) -> Vec<f32> {
+        (0..top)
+            .map(|level| {
+                let stride = 1u32 << (top - level);
+                let vertices = (n - 1) << level;
+                (0..FACES)
+                    .into_par_iter()
+                    .map(|face| {
+                        let mut worst = 0.0f32;
+                        for j in 0..=self.cells {
+                            for i in 0..=self.cells {
+                                let (ci, cj) = (
+                                    (i / stride).min(vertices - 1),
+                                    (j / stride).min(vertices - 1),
+                                );
+                                let (fx, fy) = (
+                                    (i - ci * stride) as f32 / stride as f32,
+                                    (j - cj * stride) as f32 / stride as f32,
+                                );
+                                let corner = |di: u32, dj: u32| {
+                                    self.get(face, (ci + di) * stride, (cj + dj) * stride)
+                                };
+                                let bilinear = (corner(0, 0) * (1.0 - fx) + corner(1, 0) * fx)
+                                    * (1.0 - fy)
+                                    + (corner(0, 1) * (1.0 - fx) + corner(1, 1) * fx) * fy;
+                                worst = worst.max((self.get(face, i, j) - bilinear).abs());
+                            }
+                        }
+                        worst
+                    })
+                    .reduce(|| 0.0, f32::max)
+            })
+            .collect()
+    }
 }
 
 /// Area on the unit sphere represented by lattice point (i, j) of one face: the gnomonic Jacobian times the

@@ -100,6 +100,9 @@ pub struct Planet {
     /// Per level 0..=precomputed_level, per patch (face, then row-major): lowest and highest height of the
     /// patch's points, border included.
     bounds: Vec<Vec<(f32, f32)>>,
+    /// Per level 0..precomputed_level: how far the precomputed lattice stands from a patch of that level's
+    /// bilinear surface at most (`FaceLattice::level_deviations`).
+    deviations: Vec<f32>,
     pub mountains: Vec<Mountain>,
     pub features: Option<FeaturePoints>,
     /// The rivers and lakes of the drainage model (`None` for the thesis's model).
@@ -301,6 +304,7 @@ impl Planet {
     ) -> Self {
         stats.mountains = mountains.len();
         let bounds = lattice.patch_bounds_pyramid(precomputed_level, config.rendering.vertices);
+        let deviations = lattice.level_deviations(precomputed_level, config.rendering.vertices);
         stats.memory_bytes = lattice.bytes();
         log::info!("planet: {stats:?}");
         Self {
@@ -312,11 +316,27 @@ impl Planet {
             precomputed_level,
             rule,
             bounds,
+            deviations,
             mountains,
             features,
             drainage,
             stats,
         }
+    }
+
+    /// The geometric error of a patch of `level` (beyond the thesis, for screen-space-error level of detail): how
+    /// far its surface can stand from the finest surface, vertically, plus how far its flat triangles stand
+    /// inside the sphere. Below the precomputed level, the measured deviation from the precomputed lattice plus
+    /// what finer levels add; from it on, what finer levels add (`DetailRule::remaining_range`, a bound). The
+    /// chord's sagitta is `s^2 / (8 radius)` for the vertex spacing `s` along a face.
+    pub fn geometric_error(&self, level: u32) -> f64 {
+        let detail = match self.deviations.get(level as usize) {
+            Some(d) => d + self.rule.remaining_range(self.precomputed_level),
+            None => self.rule.remaining_range(level),
+        } as f64;
+        let spacing = self.radius * std::f64::consts::FRAC_PI_2
+            / ((self.vertices - 1) as f64 * (1u64 << level) as f64);
+        detail + spacing * spacing / (8.0 * self.radius)
     }
 
     /// The base height at a unit direction, bilinear on the precomputed lattice (finer levels add at most

@@ -3,8 +3,9 @@
 //! GPU times in the title bar. Survives resize and minimise.
 //!
 //! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look, Shift faster; M water mode,
-//! F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, K simple/tiled
-//! kernel, P screenshot, Escape quit.
+//! F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
+//! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, P screenshot, Escape
+//! quit.
 
 use std::{collections::HashSet, path::PathBuf, time::Instant};
 
@@ -24,6 +25,7 @@ use super::{
     target::{create_depth, Offscreen, DEPTH_FORMAT},
 };
 use crate::{
+    config::LodRule,
     gpu::{
         pipeline::RenderTarget,
         swapchain::{self, Surface, Swapchain, SWAPCHAIN_FORMAT},
@@ -331,7 +333,7 @@ impl App<'_> {
         let gpu = |name: &str| stats.gpu_ms.get(name).copied().unwrap_or(0.0);
         window.set_title(&format!(
             "riverplanet | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} ms | {} patches ({} new) | \
-             altitude {:.1} | water {:?}{}{}",
+             altitude {:.1} | water {:?}{}{}{}",
             self.smoothed_ms,
             1000.0 / self.smoothed_ms.max(1e-3),
             gpu("kernel"),
@@ -343,6 +345,7 @@ impl App<'_> {
             renderer.map(|r| r.water_mode).unwrap_or(super::WaterMode::Auto),
             if renderer.is_some_and(|r| r.freeze_lod) { " | lod frozen" } else { "" },
             if renderer.is_some_and(|r| r.variant == KernelVariant::Simple) { " | simple kernel" } else { "" },
+            if renderer.is_some_and(|r| r.lod_rule == LodRule::Distance) { " | Eq. 6.1" } else { "" },
         ));
     }
 
@@ -409,6 +412,12 @@ impl App<'_> {
             }
             KeyCode::KeyZ => renderer.freeze_lod = !renderer.freeze_lod,
             KeyCode::KeyO => renderer.morphing = !renderer.morphing,
+            KeyCode::KeyG => {
+                renderer.lod_rule = match renderer.lod_rule {
+                    LodRule::ScreenSpaceError => LodRule::Distance,
+                    LodRule::Distance => LodRule::ScreenSpaceError,
+                }
+            }
             KeyCode::KeyK => {
                 renderer.variant = match renderer.variant {
                     KernelVariant::Simple => KernelVariant::Tiled,

@@ -1,4 +1,6 @@
-//! Distance-based quadtree level of detail (Section 6.2.1, Procedure 2, Eq. 6.1).
+//! Quadtree level of detail (Section 6.2.1, Procedure 2): a patch is refined while the camera is nearer than its
+//! level's switch distance, which comes from Eq. 6.1 (the thesis) or from the level's geometric error projected to
+//! a number of pixels (screen-space error, beyond the thesis).
 
 use glam::DVec3;
 
@@ -20,12 +22,62 @@ pub fn threshold(radius: f64, switch_factor: f64, lod: u32) -> f64 {
     radius * switch_factor / (1u64 << lod) as f64
 }
 
-/// The parameters of the selection.
-#[derive(Clone, Copy, Debug)]
+/// The parameters of the selection: the switch distance of every level.
+#[derive(Clone, Debug)]
 pub struct LodParams {
+    /// The planet's radius: distances are measured to patches on this sphere.
     pub radius: f64,
-    pub switch_factor: f64,
+    /// Per level 0..=max_level: the distance below which a patch of that level is refined (visited).
+    pub thresholds: Vec<f64>,
     pub max_level: u32,
+}
+
+impl LodParams {
+    /// The thesis's rule: Eq. 6.1 at every level.
+    pub fn distance(radius: f64, switch_factor: f64, max_level: u32) -> Self {
+        Self {
+            radius,
+            thresholds: (0..=max_level)
+                .map(|level| threshold(radius, switch_factor, level))
+                .collect(),
+            max_level,
+        }
+    }
+
+    /// Screen-space error (beyond the thesis): a patch of level L is refined (its children visited) while its
+    /// geometric error `error(L)` would cover more than `pixels` pixels, i.e. while a child is nearer than
+    /// `error(L) x pixels_per_radian / pixels`, where `pixels_per_radian` is the viewport height over
+    /// 2 tan(fov_y / 2). A level's distance is raised where needed to at least twice the next finer one's, as Eq.
+    /// 6.1's halve: a child's range then lies inside its parent's, so patches meet only patches one level apart
+    /// and morph bands stay inside their level's range, and no patch is drawn with more than `pixels` of error.
+    pub fn screen_space(
+        radius: f64,
+        error: impl Fn(u32) -> f64,
+        pixels_per_radian: f64,
+        pixels: f64,
+        max_level: u32,
+    ) -> Self {
+        // The roots are always drawn; a child of level L is visited by its parent's (level L - 1) error.
+        let mut thresholds: Vec<f64> = (0..=max_level)
+            .map(|level| match level {
+                0 => f64::INFINITY,
+                _ => error(level - 1) * pixels_per_radian / pixels,
+            })
+            .collect();
+        for level in (1..max_level as usize).rev() {
+            thresholds[level] = thresholds[level].max(2.0 * thresholds[level + 1]);
+        }
+        Self {
+            radius,
+            thresholds,
+            max_level,
+        }
+    }
+
+    /// The switch distance of `level`.
+    pub fn threshold(&self, level: u32) -> f64 {
+        self.thresholds[level.min(self.max_level) as usize]
+    }
 }
 
 /// Procedure 2 from the six roots: a child is visited while the distance from the camera to its centre, projected
@@ -103,7 +155,7 @@ fn visit(
     let mut quadrants = 0u8;
     for q in 0..4 {
         let child = patch.child(q);
-        if distance(child) < threshold(params.radius, params.switch_factor, child.level as u32) {
+        if distance(child) < params.threshold(child.level as u32) {
             visit(child, params, distance, out);
         } else {
             quadrants |= 1 << q;
@@ -114,10 +166,9 @@ fn visit(
     }
 }
 
-/// Whether `patch` is close enough to be visited (Eq. 6.1).
+/// Whether `patch` is close enough to be visited (Eq. 6.1's distance to its centre).
 pub fn refines(patch: PatchId, camera: DVec3, params: &LodParams) -> bool {
-    centre_distance(patch, camera, params.radius)
-        < threshold(params.radius, params.switch_factor, patch.level as u32)
+    centre_distance(patch, camera, params.radius) < params.threshold(patch.level as u32)
 }
 
 /// Eq. 6.1's distance: from the camera to the patch centre projected onto the sphere.

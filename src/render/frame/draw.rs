@@ -14,11 +14,7 @@ use crate::{
     },
     planet::cube::{cube_point, PatchId, EDGES, FACE_AXES},
     river::samples::PatchFrame,
-    runtime::{
-        cache::PatchData,
-        camera::Camera,
-        lod::{threshold, Selected},
-    },
+    runtime::{cache::PatchData, camera::Camera, lod::Selected},
 };
 
 #[repr(C)]
@@ -134,8 +130,7 @@ impl Renderer<'_> {
         if !self.morphing || patch.level == 0 {
             return NO_MORPH;
         }
-        let p = self.lod_params();
-        let end = threshold(p.radius, p.switch_factor, patch.level as u32);
+        let end = self.lod.threshold(patch.level as u32);
         let half = (self.config.rendering.vertices - 1) / 2;
         [
             (end * (1.0 - MORPH_BAND)) as f32,
@@ -220,6 +215,11 @@ impl Renderer<'_> {
                 SKIRT_SPACINGS * instance.centre_dir[3] + skirt_deficit(s.patch, &stand_ins);
             drawn.push((instance, wet, s.patch));
         }
+        // Near to far, so that depth testing rejects what nearer patches hide before it is shaded.
+        drawn.sort_by(|a, b| {
+            let distance = |p: &PatchId| camera.position.distance_squared(p.center() * radius);
+            distance(&a.2).total_cmp(&distance(&b.2))
+        });
         let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 3);
         let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
         let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
@@ -349,6 +349,7 @@ impl Renderer<'_> {
             &self.terrain
         };
         for (indices, instances) in self.quadrant_ranges.iter().zip(&quadrant_instances) {
+            stats.terrain_triangles += (indices.len() / 3 * instances.len()) as u64;
             rec.draw_indexed(
                 terrain,
                 &sets,

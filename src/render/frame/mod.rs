@@ -15,7 +15,7 @@ use self::draw::FramePush;
 pub use self::draw::{DrawnVertex, PatchInstance, VertexCapture};
 use super::mesh::{patch_mesh, PatchMesh};
 use crate::{
-    config::Config,
+    config::{Config, LodRule},
     gpu::{
         bindless::{Bindless, Slot},
         frames::{Finished, FrameRing, FRAMES_IN_FLIGHT},
@@ -29,7 +29,12 @@ use crate::{
     planet::Planet,
     refine::HeightRefiner,
     river::network::RiverNetwork,
-    runtime::{cache::PatchCache, camera::Camera, cull::HeightRange, lod::Selected},
+    runtime::{
+        cache::PatchCache,
+        camera::Camera,
+        cull::HeightRange,
+        lod::{LodParams, Selected},
+    },
     shaders,
 };
 
@@ -88,6 +93,8 @@ pub struct FrameStats {
     pub pending_patches: usize,
     /// The finest level drawn with its own data.
     pub deepest_level: u32,
+    /// Triangles the terrain pass draws (the patches' quadrants with their skirts; the water pass spawns its own).
+    pub terrain_triangles: u64,
     pub samples: usize,
     pub resident_patches: usize,
     pub evicted_patches: usize,
@@ -172,6 +179,8 @@ pub struct Renderer<'w> {
     heights: HeightRange,
     frame: u64,
     frozen: Option<Vec<Selected>>,
+    /// This frame's switch distances (`lod_rule`, the camera and the viewport).
+    lod: LodParams,
     /// GPU milliseconds per new patch (base heights and river data), averaged over recent frames: what the
     /// generation budget divides by.
     generation_ms_per_patch: Option<f64>,
@@ -187,6 +196,8 @@ pub struct Renderer<'w> {
     /// parent's river data at their shared vertices and computes only the rest; `false`: every patch from
     /// scratch, as the thesis.
     pub parent_reuse: bool,
+    /// How patches are refined (from `level-of-detail-rule`; `Distance` is the thesis's Eq. 6.1).
+    pub lod_rule: LodRule,
     /// Unit direction towards the sun; `None`: over the camera's shoulder.
     pub sun: Option<DVec3>,
     /// Keep each frame's kernel input in `last_batch` (for benchmarks that rerun it through every variant).
@@ -297,6 +308,12 @@ impl<'w> Renderer<'w> {
             heights,
             frame: 0,
             frozen: None,
+            lod: LodParams::distance(
+                planet.radius,
+                config.rendering.level_of_detail_switch_factor as f64,
+                config.rendering.max_level_of_detail,
+            ),
+            lod_rule: config.rendering.level_of_detail_rule,
             generation_ms_per_patch: None,
             variant: KernelVariant::Tiled,
             water_mode: WaterMode::Auto,
@@ -370,6 +387,7 @@ impl<'w> Renderer<'w> {
         };
         let mut cpu = BTreeMap::new();
 
+        self.lod = self.lod_params(camera, target.extent.height);
         let visible = self.visible_patches(camera, &mut stats, &mut cpu);
         let plan = self.plan_streaming(camera, &visible, &mut stats)?;
 

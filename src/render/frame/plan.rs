@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use super::{ms_since, FrameStats, Renderer};
 use crate::{
+    config::LodRule,
     gpu::GpuError,
     planet::cube::PatchId,
     refine::with_ancestors,
@@ -18,11 +19,24 @@ use crate::{
 };
 
 impl Renderer<'_> {
-    pub(super) fn lod_params(&self) -> LodParams {
-        LodParams {
-            radius: self.planet.radius,
-            switch_factor: self.config.rendering.level_of_detail_switch_factor as f64,
-            max_level: self.config.rendering.max_level_of_detail,
+    /// The switch distances of this frame: Eq. 6.1, or the levels' geometric errors projected to `pixel-error`
+    /// pixels of a viewport `viewport_height` pixels high seen through `camera`.
+    pub(super) fn lod_params(&self, camera: &Camera, viewport_height: u32) -> LodParams {
+        let r = &self.config.rendering;
+        let radius = self.planet.radius;
+        match self.lod_rule {
+            LodRule::Distance => LodParams::distance(
+                radius,
+                r.level_of_detail_switch_factor as f64,
+                r.max_level_of_detail,
+            ),
+            LodRule::ScreenSpaceError => LodParams::screen_space(
+                radius,
+                |level| self.planet.geometric_error(level),
+                viewport_height as f64 / (2.0 * (0.5 * camera.fov_y).tan()),
+                r.pixel_error as f64,
+                r.max_level_of_detail,
+            ),
         }
     }
 
@@ -42,14 +56,14 @@ impl Renderer<'_> {
             _ if self.morphing => {
                 let depth = self.config.river.basin_depth as f64;
                 let cache = &self.cache;
-                select_nearest(camera.position, &self.lod_params(), &|p| {
+                select_nearest(camera.position, &self.lod, &|p| {
                     let nearest = cache
                         .nearest_resident(p)
                         .map(|(q, data)| (q.level, data.surface_range()));
                     surface_bounds(self.planet, depth, p, nearest)
                 })
             }
-            _ => select(camera.position, &self.lod_params()),
+            _ => select(camera.position, &self.lod),
         };
         self.frozen = Some(selected.clone());
         cpu.insert("lod".to_string(), ms_since(t));
