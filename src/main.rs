@@ -80,6 +80,7 @@ fn main() -> ExitCode {
             long_flight,
             kernel_reuse,
             descent,
+            frame_flight,
             commands,
             out,
         } => {
@@ -92,6 +93,7 @@ fn main() -> ExitCode {
                 long_flight: long_flight.as_deref(),
                 kernel_reuse: kernel_reuse.as_deref(),
                 descents: &descent,
+                frame_flights: &frame_flight,
                 commands: &commands,
             };
             match bench::report::results_markdown(&inputs)

@@ -33,6 +33,8 @@ pub struct ReportInputs<'a> {
     pub kernel_reuse: Option<&'a Path>,
     /// Reports of `bench flight --descent` (any number: planets, thesis mode).
     pub descents: &'a [std::path::PathBuf],
+    /// Reports of `bench flight` on the default planet with each level-of-detail rule and frames in flight.
+    pub frame_flights: &'a [std::path::PathBuf],
     /// The command lines that made the inputs, for the record.
     pub commands: &'a str,
 }
@@ -315,12 +317,50 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         }
         let _ = writeln!(w);
     }
+    if !inputs.frame_flights.is_empty() {
+        frame_section(w, inputs.frame_flights)?;
+    }
     let _ = writeln!(
         w,
         "## How these numbers were made\n\n```sh\n{}\n```",
         inputs.commands.trim()
     );
     Ok(md)
+}
+
+/// The default planet's scripted approach with each level-of-detail rule and number of frames in flight: what a
+/// frame costs and how many triangles it draws (issue "The frame").
+fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), PlotError> {
+    let _ = writeln!(
+        w,
+        "## The frame on the default planet\n\nBeyond the thesis: the scripted approach on config/planet.xml at the \
+         resolution given, in the default water mode, with each level-of-detail rule (screen-space error, the \
+         default; `distance`, the thesis's Eq. 6.1) and number of frames in flight. Frame times are wall-clock \
+         per frame, waits for the GPU included.\n\n\
+         | report | level of detail | frames in flight | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) |\n\
+         |---|---|---|---|---|---|---|---|"
+    );
+    for path in paths {
+        let d = read(path)?;
+        let s = &d["summary"];
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} |",
+            path.file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+            d["lod_rule"].as_str().unwrap_or("?"),
+            d["frames_in_flight"],
+            s["frames"],
+            d["resolution"][0],
+            d["resolution"][1],
+            f(&s["triangles_mean"]),
+            f(&s["frame_ms_mean"]),
+            f(&s["frame_ms_median"]),
+            f(&s["average_gpu_ms"]["terrain"]),
+        );
+    }
+    let _ = writeln!(w);
+    Ok(())
 }
 
 /// The comparison of `bench kernel --parent-reuse`: river data from the parent against from scratch.

@@ -92,6 +92,10 @@ pub enum Command {
         /// Reports of `bench flight --descent` (repeat the option for several).
         #[arg(long)]
         descent: Vec<PathBuf>,
+        /// Reports of `bench flight` on the default planet, one per level-of-detail rule or frames in flight
+        /// (repeat the option for several).
+        #[arg(long)]
+        frame_flight: Vec<PathBuf>,
         /// A file with the commands that made the reports (quoted in the document).
         #[arg(long)]
         commands: PathBuf,
