@@ -33,7 +33,7 @@ fn main() -> ExitCode {
             preview,
             equirect,
             level,
-        } => match generate(&config, &out, seed, (preview, equirect), level) {
+        } => match generate(config.as_deref(), &out, seed, (preview, equirect), level) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e:#}");
@@ -209,10 +209,32 @@ pub(crate) fn check_output(
     riverplanet::export::files::check_output(argument, path, png_only).map_err(anyhow::Error::msg)
 }
 
-pub(crate) fn load_config(path: &std::path::Path) -> anyhow::Result<Config> {
-    let config = Config::load(path)?;
-    log::info!("resolved configuration: {config:?}");
-    Ok(config)
+/// The configuration file used when `--config` is not given, if it exists.
+const DEFAULT_CONFIG: &str = "config/planet.xml";
+
+/// The configuration of `path`; without one, config/planet.xml if there is one here, or else the built-in default
+/// (`Config::default()`: Appendix A's planet with the drainage model, seed 1), so the binary runs from any folder.
+/// Returns it with where it came from, for messages.
+pub(crate) fn load_config(path: Option<&std::path::Path>) -> anyhow::Result<(Config, String)> {
+    let default = std::path::Path::new(DEFAULT_CONFIG);
+    let (config, source) = match path {
+        Some(path) => (Config::load(path)?, path.display().to_string()),
+        None if default.exists() => (Config::load(default)?, DEFAULT_CONFIG.to_string()),
+        None => (
+            Config::default(),
+            "the built-in default configuration".to_string(),
+        ),
+    };
+    log::info!("resolved configuration of {source}: {config:?}");
+    Ok((config, source))
+}
+
+/// The planet's seed: `--seed`, or else the configuration's `master-seed` (a new one each run if -1). Printed, so
+/// that a planet can always be made again.
+pub(crate) fn planet_seed(seed: Option<u32>, config: &Config) -> u32 {
+    let seed = seed.unwrap_or_else(|| config.resolve_seed());
+    println!("seed: {seed} (--seed {seed} makes this planet again)");
+    seed
 }
 
 pub(crate) fn write_json(

@@ -406,3 +406,69 @@ fn benchmark_counts_and_speeds_must_be_positive() {
         assert!(stderr.contains(option), "{args:?}: {stderr}");
     }
 }
+
+/// The seed a command printed (`seed: N ...`).
+fn printed_seed(stdout: &[u8]) -> u32 {
+    let text = String::from_utf8_lossy(stdout);
+    text.lines()
+        .find_map(|l| l.strip_prefix("seed: "))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no seed printed in {text}"))
+}
+
+#[test]
+fn a_new_planet_prints_its_seed_and_that_seed_makes_it_again() {
+    let dir = temp_dir("seed");
+    let generate = |out: &str, seed: Option<u32>| {
+        let mut command = riverplanet();
+        command
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["generate", "--level", "0", "--out"])
+            .arg(dir.join(out));
+        if let Some(seed) = seed {
+            command.args(["--seed", &seed.to_string()]);
+        }
+        let run = command.output().unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        (
+            printed_seed(&run.stdout),
+            std::fs::read(dir.join(out).join("faces/face0.png")).unwrap(),
+        )
+    };
+    // config/planet.xml has master-seed -1: a new planet each run, whose seed is printed.
+    let (seed, first) = generate("first", None);
+    let (again, second) = generate("again", Some(seed));
+    assert_eq!(again, seed);
+    assert!(first == second, "--seed {seed} made a different planet");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn outside_the_repository_the_built_in_default_configuration_is_used() {
+    let dir = temp_dir("anywhere");
+    let run = riverplanet()
+        .current_dir(&dir)
+        .args(["generate", "--level", "0", "--out", "out"])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // The built-in default is Appendix A's planet with the drainage model and seed 1.
+    assert_eq!(printed_seed(&run.stdout), 1);
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/stats.json")).unwrap())
+            .unwrap();
+    assert!(
+        !stats["strahler_max"].is_null(),
+        "drainage measures in {stats}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

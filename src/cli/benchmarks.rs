@@ -22,7 +22,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             tile_size,
             json,
         } => {
-            let config = load_config(&planet.config)?;
+            let (config, _) = load_config(planet.config.as_deref())?;
             if let Some(path) = &json {
                 check_output("--json", path, false)?;
             }
@@ -101,7 +101,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             csv,
         } => {
             use std::io::IsTerminal;
-            let config = load_config(&planet.config)?;
+            let (config, _) = load_config(planet.config.as_deref())?;
             for (argument, path) in [("--json", Some(&json)), ("--csv", csv.as_ref())] {
                 if let Some(path) = path {
                     check_output(argument, path, false)?;

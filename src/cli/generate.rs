@@ -1,6 +1,6 @@
 //! `riverplanet generate`: the planet's face images, preview, rivers and statistics.
 
-use crate::load_config;
+use crate::{load_config, planet_seed};
 
 /// The finest level `generate` writes face images at (8193 pixels per edge with 33 vertices).
 const MAX_FACE_IMAGE_LEVEL: u32 = 8;
@@ -8,14 +8,14 @@ const MAX_FACE_IMAGE_LEVEL: u32 = 8;
 const DEFAULT_FACE_IMAGE_LEVEL: u32 = 6;
 
 pub fn generate(
-    config_path: &std::path::Path,
+    config_path: Option<&std::path::Path>,
     out: &std::path::Path,
     seed: Option<u32>,
     (preview, equirect): (bool, bool),
     level: Option<u32>,
 ) -> anyhow::Result<()> {
     use std::io::IsTerminal;
-    let config = load_config(config_path)?;
+    let (config, source) = load_config(config_path)?;
     let deepest = config
         .rendering
         .max_level_of_detail
@@ -26,11 +26,11 @@ pub fn generate(
             "--level {level} must be in [0, {deepest}] (max-level-of-detail {} of {}; face images stop at \
              level {MAX_FACE_IMAGE_LEVEL}, {} pixels per edge)",
             config.rendering.max_level_of_detail,
-            config_path.display(),
+            source,
             ((config.rendering.vertices - 1) << MAX_FACE_IMAGE_LEVEL) + 1
         );
     }
-    let seed = seed.unwrap_or_else(|| config.resolve_seed());
+    let seed = planet_seed(seed, &config);
     let bar = if std::io::stderr().is_terminal() {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.enable_steady_tick(std::time::Duration::from_millis(100));

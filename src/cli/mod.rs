@@ -40,8 +40,10 @@ pub enum Command {
     Config { file: PathBuf },
     /// Generate the planet: per-face heightmaps, statistics and (with --preview) an unfolded picture.
     Generate {
-        #[arg(long, default_value = "config/planet.xml")]
-        config: PathBuf,
+        /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
+        /// planet with the drainage model].
+        #[arg(long)]
+        config: Option<PathBuf>,
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
@@ -111,8 +113,10 @@ pub enum Command {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    #[arg(long, default_value = "config/planet.xml")]
-    pub config: PathBuf,
+    /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
+    /// planet with the drainage model].
+    #[arg(long)]
+    pub config: Option<PathBuf>,
     /// Override master-seed.
     #[arg(long)]
     pub seed: Option<u32>,
@@ -155,8 +159,10 @@ pub struct RenderArgs {
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
-    #[arg(long, default_value = "config/planet.xml")]
-    pub config: PathBuf,
+    /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
+    /// planet with the drainage model].
+    #[arg(long)]
+    pub config: Option<PathBuf>,
     #[arg(long)]
     pub seed: Option<u32>,
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
@@ -178,8 +184,10 @@ pub struct ViewArgs {
 /// The planet a benchmark runs on.
 #[derive(clap::Args)]
 pub struct BenchPlanet {
-    #[arg(long, default_value = "config/planet.xml")]
-    pub config: PathBuf,
+    /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
+    /// planet with the drainage model].
+    #[arg(long)]
+    pub config: Option<PathBuf>,
     #[arg(long, default_value_t = 1)]
     pub seed: u32,
 }

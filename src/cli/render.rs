@@ -3,12 +3,11 @@
 use riverplanet::gpu::{self, Context, ContextOptions};
 
 use super::{RenderArgs, ViewArgs};
-use crate::{check_output, load_config};
+use crate::{check_output, load_config, planet_seed};
 
 pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
-    let config = load_config(&args.config)?;
+    let (config, _) = load_config(args.config.as_deref())?;
     check_output("--out", &args.out, true)?;
-    let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
     if args.preset.is_none() && args.eye.length() <= config.planet.radius as f64 * 0.5 {
         anyhow::bail!(
             "--eye {} is inside the planet (radius {})",
@@ -22,6 +21,7 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     if !(1.0..=170.0).contains(&args.fov) {
         anyhow::bail!("--fov {} must be in [1, 170] degrees", args.fov);
     }
+    let seed = planet_seed(args.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.preset {
         Some(preset) => riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
@@ -96,11 +96,11 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
 }
 
 pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
-    let config = load_config(&args.config)?;
+    let (config, _) = load_config(args.config.as_deref())?;
     if let Some(path) = &args.screenshot {
         check_output("--screenshot", path, true)?;
     }
-    let seed = args.seed.unwrap_or_else(|| config.resolve_seed());
+    let seed = planet_seed(args.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.eye {
         Some(eye) => (eye, args.look_at),

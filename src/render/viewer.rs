@@ -1,6 +1,6 @@
 //! The native viewer (winit): a fly camera whose speed scales with altitude, keys for the water mode, wireframe,
-//! level-of-detail colours, freezing the level of detail, the kernel variant and screenshots; frame and per-pass
-//! GPU times in the title bar. Survives resize and minimise.
+//! level-of-detail colours, freezing the level of detail, the kernel variant and screenshots; the seed, frame and
+//! per-pass GPU times in the title bar. Survives resize and minimise.
 //!
 //! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look, Shift faster; M water mode,
 //! F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
@@ -332,8 +332,9 @@ impl App<'_> {
         let renderer = self.renderer.as_ref();
         let gpu = |name: &str| stats.gpu_ms.get(name).copied().unwrap_or(0.0);
         window.set_title(&format!(
-            "riverplanet | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} ms | {} patches ({} new) | \
-             altitude {:.1} | water {:?}{}{}{}",
+            "riverplanet | seed {} | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} ms | {} patches \
+             ({} new) | altitude {:.1} | water {:?}{}{}{}",
+            self.world.seed,
             self.smoothed_ms,
             1000.0 / self.smoothed_ms.max(1e-3),
             gpu("kernel"),

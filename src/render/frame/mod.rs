@@ -332,8 +332,8 @@ impl<'w> Renderer<'w> {
 
     /// Renders frames of `camera` into `target` until every visible patch has its own data (or `max_frames` were
     /// rendered): what a still image needs. The colour image is in `*layout` and is left in
-    /// COLOR_ATTACHMENT_OPTIMAL (`*layout` says so afterwards). Returns the last frame's statistics and the number
-    /// of frames.
+    /// COLOR_ATTACHMENT_OPTIMAL (`*layout` says so afterwards). Waits for every frame; returns the last frame's
+    /// statistics (its GPU times, and its time until the GPU finished it) and the number of frames.
     pub fn render_until_streamed(
         &mut self,
         camera: &Camera,
@@ -343,6 +343,7 @@ impl<'w> Renderer<'w> {
     ) -> Result<(FrameStats, u32), GpuError> {
         let mut frames = 0;
         loop {
+            let start = Instant::now();
             let stats = self.render(
                 camera,
                 target,
@@ -355,6 +356,8 @@ impl<'w> Renderer<'w> {
             if stats.streamed() || frames >= max_frames {
                 let mut stats = stats;
                 self.finish()?;
+                // The last frame's time to its completion on the GPU.
+                stats.frame_ms = ms_since(start);
                 if let Some(last) = self.gpu_times.last() {
                     stats.gpu_ms = last.ms.clone();
                     stats.gpu_frame = last.frame;
