@@ -115,7 +115,7 @@ pub struct RiverConfig {
 pub enum LodRule {
     /// Beyond the thesis: refine while a patch's geometric error would cover more than `pixel-error` pixels.
     ScreenSpaceError,
-    /// The thesis's Eq. 6.1: refine while nearer than radius x switch factor / 2^level.
+    /// The thesis's Eq. 6.1 (the default): refine while nearer than radius x switch factor / 2^level.
     Distance,
 }
 
@@ -147,15 +147,13 @@ pub struct Config {
 }
 
 impl Config {
-    /// The defaults of a file with `model`: Appendix A's values (`appendix_a`) with the screen-space-error level of
-    /// detail (the product's rule; `<level-of-detail-rule>distance</level-of-detail-rule>` selects Eq. 6.1), and
-    /// for the drainage model the values config/planet.xml was tuned with (docs/rivers.md): a river where 700
+    /// The defaults of a file with `model`: Appendix A's values (`appendix_a`), and for the drainage model the
+    /// values config/planet.xml was tuned with (docs/rivers.md): a river where 700
     /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), and at most four
     /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples).
     pub fn defaults_for(model: RiverModel) -> Self {
         let mut d = Self::appendix_a();
         d.river.model = model;
-        d.rendering.level_of_detail_rule = LodRule::ScreenSpaceError;
         if model == RiverModel::Drainage {
             d.planet.detail_amplitude = 2.0;
             d.river.source_area = 700.0;
@@ -164,8 +162,8 @@ impl Config {
         d
     }
 
-    /// The values of Appendix A with the thesis's river model and level of detail (Eq. 6.1), and `master-seed` 1
-    /// instead of -1 so the planet is reproducible: the planet of the thesis's Chapter 9 experiments.
+    /// The values of Appendix A with the thesis's river model, and `master-seed` 1 instead of -1 so the planet is
+    /// reproducible: the planet of the thesis's Chapter 9 experiments.
     pub fn appendix_a() -> Self {
         Self {
             planet: PlanetConfig {
