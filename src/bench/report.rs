@@ -288,8 +288,8 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             "## The descent to the ground\n\nBeyond the thesis: `bench flight --descent` from three radii out to 2 world \
              units above the first river's water (60 % of the frames), then turning a quarter round there; every tenth \
              frame is checked for holes (docs/rendering.md). Frame times include waiting for the GPU.\n\n\
-             | report | river model | planet radius | morphing | river data from the parent | frames | deepest level | peak memory | frame ms median | max after 10 frames | max / median | hole pixels (frames checked) |\n\
-             |---|---|---|---|---|---|---|---|---|---|---|---|"
+             | report | river model | level of detail | planet radius | morphing | river data from the parent | frames | deepest level | peak memory | frame ms median | max after 10 frames | max / median | hole pixels (frames checked) |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
         for path in inputs.descents {
             let d = read(path)?;
@@ -297,9 +297,10 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             let _ =
                 writeln!(
                 w,
-                "| {} | {} | {} | {} | {} | {} at {}x{} | {} | {:.1} MB | {:.1} | {:.1} | {:.2} | {} ({}) |",
+                "| {} | {} | {} | {} | {} | {} | {} at {}x{} | {} | {:.1} MB | {:.1} | {:.1} | {:.2} | {} ({}) |",
                 path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 d["river_model"].as_str().unwrap_or("thesis"),
+                d["lod_rule"].as_str().unwrap_or("distance"),
                 d["radius"],
                 if d["morphing"].as_bool().unwrap_or(true) { "yes" } else { "no (thesis)" },
                 if d["parent_reuse"].as_bool().unwrap_or(true) { "yes" } else { "no (thesis)" },
