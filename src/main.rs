@@ -84,7 +84,13 @@ fn main() -> ExitCode {
             commands,
             out,
         } => {
-            let commands = std::fs::read_to_string(&commands).unwrap_or_default();
+            let commands = match std::fs::read_to_string(&commands) {
+                Ok(text) => text,
+                Err(e) => {
+                    eprintln!("error: --commands {}: {e}", commands.display());
+                    return ExitCode::from(2);
+                }
+            };
             let inputs = bench::report::ReportInputs {
                 kernel: &kernel,
                 kernel_stress: &kernel_stress,

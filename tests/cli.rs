@@ -472,3 +472,53 @@ fn outside_the_repository_the_built_in_default_configuration_is_used() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_viewer_refuses_a_camera_inside_the_planet_or_looking_at_itself_before_opening_a_window() {
+    for (eye, look_at, expected) in [
+        ("0,0,0", "0,0,1", "is inside the planet"),
+        ("0,0,3000", "0,0,3000", "--look-at must differ from --eye"),
+    ] {
+        let run = riverplanet()
+            .args(["view", "--eye", eye, "--look-at", look_at, "--frames", "1"])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success(),
+            "accepted --eye {eye} --look-at {look_at}"
+        );
+        assert!(stderr.contains(expected), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
+
+#[test]
+fn report_names_a_missing_commands_file() {
+    let dir = temp_dir("report");
+    let missing = dir.join("missing.txt");
+    let run = riverplanet()
+        .args([
+            "report",
+            "--kernel",
+            "k.json",
+            "--kernel-stress",
+            "k.json",
+            "--flight",
+            "f.json",
+        ])
+        .args(["--flight-stress", "f.json", "--commands"])
+        .arg(&missing)
+        .arg("--out")
+        .arg(dir.join("results.md"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--commands"), "{stderr}");
+    assert!(!dir.join("results.md").exists(), "a report was written");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -8,15 +8,8 @@ use crate::{check_output, load_config, planet_seed};
 pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     let (config, _) = load_config(args.config.as_deref())?;
     check_output("--out", &args.out, true)?;
-    if args.preset.is_none() && args.eye.length() <= config.planet.radius as f64 * 0.5 {
-        anyhow::bail!(
-            "--eye {} is inside the planet (radius {})",
-            args.eye,
-            config.planet.radius
-        );
-    }
-    if (args.look_at - args.eye).length() < 1e-9 {
-        anyhow::bail!("--look-at must differ from --eye");
+    if args.preset.is_none() {
+        check_camera(args.eye, args.look_at, &config)?;
     }
     if !(1.0..=170.0).contains(&args.fov) {
         anyhow::bail!("--fov {} must be in [1, 170] degrees", args.fov);
@@ -95,10 +88,32 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     Ok(())
 }
 
+/// Refuses a camera inside the planet (below half its radius: the terrain never reaches there) or one that looks
+/// at itself, before any work.
+fn check_camera(
+    eye: glam::DVec3,
+    look_at: glam::DVec3,
+    config: &riverplanet::config::Config,
+) -> anyhow::Result<()> {
+    if eye.length() <= config.planet.radius as f64 * 0.5 {
+        anyhow::bail!(
+            "--eye {eye} is inside the planet (radius {})",
+            config.planet.radius
+        );
+    }
+    if (look_at - eye).length() < 1e-9 {
+        anyhow::bail!("--look-at must differ from --eye");
+    }
+    Ok(())
+}
+
 pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
     let (config, _) = load_config(args.config.as_deref())?;
     if let Some(path) = &args.screenshot {
         check_output("--screenshot", path, true)?;
+    }
+    if let Some(eye) = args.eye {
+        check_camera(eye, args.look_at, &config)?;
     }
     let seed = planet_seed(args.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
