@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use riverplanet::{
     bench,
-    config::Config,
+    config::{Config, ConfigError},
     gpu::{self, Context, ContextOptions},
 };
 mod cli;
@@ -33,45 +33,19 @@ fn main() -> ExitCode {
             preview,
             equirect,
             level,
-        } => match generate(config.as_deref(), &out, seed, (preview, equirect), level) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Render(args) => match render(&options, &args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                ExitCode::FAILURE
-            }
-        },
+        } => finish(generate(
+            config.as_deref(),
+            &out,
+            seed,
+            (preview, equirect),
+            level,
+        )),
+        Command::Render(args) => finish(render(&options, &args)),
         Command::Plot {
             flight,
             stress,
             out,
-        } => {
-            let mut result = bench::plot::flight_figures(&flight, &out, "", false);
-            if let (Ok(names), Some(stress)) = (&mut result, stress) {
-                match bench::plot::flight_figures(&stress, &out, "stress_", true) {
-                    Ok(more) => names.extend(more),
-                    Err(e) => result = Err(e),
-                }
-            }
-            match result {
-                Ok(names) => {
-                    for n in names {
-                        println!("{}", out.join(n).with_extension("png").display());
-                    }
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
-        }
+        } => finish(plot(&flight, stress.as_deref(), &out)),
         Command::Report {
             kernel,
             kernel_stress,
@@ -83,14 +57,9 @@ fn main() -> ExitCode {
             frame_flight,
             commands,
             out,
-        } => {
-            let commands = match std::fs::read_to_string(&commands) {
-                Ok(text) => text,
-                Err(e) => {
-                    eprintln!("error: --commands {}: {e}", commands.display());
-                    return ExitCode::from(2);
-                }
-            };
+        } => finish((|| {
+            let commands = std::fs::read_to_string(&commands)
+                .map_err(|e| usage(format!("--commands {}: {e}", commands.display())))?;
             let inputs = bench::report::ReportInputs {
                 kernel: &kernel,
                 kernel_stress: &kernel_stress,
@@ -102,54 +71,67 @@ fn main() -> ExitCode {
                 frame_flights: &frame_flight,
                 commands: &commands,
             };
-            match bench::report::results_markdown(&inputs)
-                .map(|md| riverplanet::export::files::write_bytes(&out, md.as_bytes()))
-            {
-                Ok(Ok(())) => ExitCode::SUCCESS,
-                Ok(Err(e)) => {
-                    eprintln!("error: cannot write {}: {e}", out.display());
-                    ExitCode::FAILURE
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
+            let md = bench::report::results_markdown(&inputs)?;
+            riverplanet::export::files::write_bytes(&out, md.as_bytes())
+                .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", out.display()))
+        })()),
+        Command::View(args) => finish(view(&options, &args)),
+        Command::Bench { what } => finish(run_bench(&options, what)),
+        Command::Config { file } => finish((|| {
+            let config = Config::load(&file)?;
+            log::info!("resolved configuration: {config:?}");
+            println!("{}", serde_json::to_string_pretty(&config)?);
+            Ok(())
+        })()),
+    }
+}
+
+/// A mistake in how the program was called: an argument's value or an output path. Exit code 2, as clap's own
+/// usage errors and configuration errors; everything else that fails at run time exits 1.
+#[derive(Debug)]
+pub(crate) struct Usage(String);
+
+impl std::fmt::Display for Usage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Usage {}
+
+pub(crate) fn usage(message: impl Into<String>) -> anyhow::Error {
+    anyhow::Error::new(Usage(message.into()))
+}
+
+/// The one place errors become exit codes: 2 for usage and configuration errors, 1 for the rest.
+fn finish(result: anyhow::Result<()>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            if e.downcast_ref::<Usage>().is_some() || e.downcast_ref::<ConfigError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::FAILURE
             }
         }
-        Command::View(args) => match view(&options, &args) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Bench { what } => match run_bench(&options, what) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Config { file } => match Config::load(&file) {
-            Ok(config) => {
-                log::info!("resolved configuration: {config:?}");
-                match serde_json::to_string_pretty(&config) {
-                    Ok(text) => {
-                        println!("{text}");
-                        ExitCode::SUCCESS
-                    }
-                    Err(e) => {
-                        eprintln!("error: {e}");
-                        ExitCode::FAILURE
-                    }
-                }
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::from(2)
-            }
-        },
     }
+}
+
+/// Figures 9.1-9.8 from the flight reports, printing the PNGs written.
+fn plot(
+    flight: &std::path::Path,
+    stress: Option<&std::path::Path>,
+    out: &std::path::Path,
+) -> anyhow::Result<()> {
+    let mut names = bench::plot::flight_figures(flight, out, "", false)?;
+    if let Some(stress) = stress {
+        names.extend(bench::plot::flight_figures(stress, out, "stress_", true)?);
+    }
+    for n in names {
+        println!("{}", out.join(n).with_extension("png").display());
+    }
+    Ok(())
 }
 
 fn info(options: &ContextOptions, json: bool) -> ExitCode {
@@ -212,7 +194,7 @@ pub(crate) fn check_output(
     path: &std::path::Path,
     png_only: bool,
 ) -> anyhow::Result<()> {
-    riverplanet::export::files::check_output(argument, path, png_only).map_err(anyhow::Error::msg)
+    riverplanet::export::files::check_output(argument, path, png_only).map_err(usage)
 }
 
 /// The configuration file used when `--config` is not given, if it exists.

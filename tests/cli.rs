@@ -128,7 +128,7 @@ fn generate_with_the_thesis_model_writes_faces_layout_stats_rivers_and_preview()
 }
 
 #[test]
-fn bad_configuration_exits_with_2_and_names_the_element() {
+fn bad_configuration_exits_with_2_from_every_command_and_names_the_element() {
     let dir = temp_dir("config");
     let config = dir.join("bad.xml");
     std::fs::write(
@@ -136,13 +136,19 @@ fn bad_configuration_exits_with_2_and_names_the_element() {
         "<planet><rendering-attributes><vertices>32</vertices></rendering-attributes></planet>",
     )
     .unwrap();
-    let output = riverplanet().arg("config").arg(&config).output().unwrap();
-    assert_eq!(output.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        stderr.contains("<vertices>") && stderr.contains("2^n+1"),
-        "{stderr}"
-    );
+    // The same exit code and message from every command that reads it.
+    for command in [
+        vec!["config"],
+        vec!["generate", "--out", "unused", "--config"],
+    ] {
+        let output = riverplanet().args(&command).arg(&config).output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{command:?}: {stderr}");
+        assert!(
+            stderr.contains("<vertices>") && stderr.contains("2^n+1"),
+            "{stderr}"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -312,7 +318,8 @@ fn bad_output_paths_are_refused_before_any_work_and_nothing_is_overwritten() {
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&run.stderr);
-        assert_eq!(run.status.code(), Some(1), "{stderr}");
+        // A usage error: exit code 2, as clap's own.
+        assert_eq!(run.status.code(), Some(2), "{stderr}");
         assert!(
             stderr.contains("--out") && stderr.contains(culprit),
             "{stderr}"

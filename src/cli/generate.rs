@@ -1,6 +1,6 @@
 //! `riverplanet generate`: the planet's face images, preview, rivers and statistics.
 
-use crate::{load_config, planet_seed};
+use crate::{load_config, planet_seed, usage};
 
 /// The finest level `generate` writes face images at (8193 pixels per edge with 33 vertices).
 const MAX_FACE_IMAGE_LEVEL: u32 = 8;
@@ -22,13 +22,13 @@ pub fn generate(
         .min(MAX_FACE_IMAGE_LEVEL);
     let level = level.unwrap_or(DEFAULT_FACE_IMAGE_LEVEL.min(deepest));
     if level > deepest {
-        anyhow::bail!(
+        return Err(usage(format!(
             "--level {level} must be in [0, {deepest}] (max-level-of-detail {} of {}; face images stop at \
              level {MAX_FACE_IMAGE_LEVEL}, {} pixels per edge)",
             config.rendering.max_level_of_detail,
             source,
             ((config.rendering.vertices - 1) << MAX_FACE_IMAGE_LEVEL) + 1
-        );
+        )));
     }
     let seed = planet_seed(seed, &config);
     let bar = if std::io::stderr().is_terminal() {

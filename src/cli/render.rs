@@ -3,7 +3,7 @@
 use riverplanet::gpu::{self, Context, ContextOptions};
 
 use super::{RenderArgs, ViewArgs};
-use crate::{check_output, load_config, planet_seed};
+use crate::{check_output, load_config, planet_seed, usage};
 
 pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     let (config, _) = load_config(args.config.as_deref())?;
@@ -12,7 +12,10 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         check_camera(args.eye, args.look_at, &config)?;
     }
     if !(1.0..=170.0).contains(&args.fov) {
-        anyhow::bail!("--fov {} must be in [1, 170] degrees", args.fov);
+        return Err(usage(format!(
+            "--fov {} must be in [1, 170] degrees",
+            args.fov
+        )));
     }
     let seed = planet_seed(args.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
@@ -96,13 +99,13 @@ fn check_camera(
     config: &riverplanet::config::Config,
 ) -> anyhow::Result<()> {
     if eye.length() <= config.planet.radius as f64 * 0.5 {
-        anyhow::bail!(
+        return Err(usage(format!(
             "--eye {eye} is inside the planet (radius {})",
             config.planet.radius
-        );
+        )));
     }
     if (look_at - eye).length() < 1e-9 {
-        anyhow::bail!("--look-at must differ from --eye");
+        return Err(usage("--look-at must differ from --eye"));
     }
     Ok(())
 }
