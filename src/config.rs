@@ -225,6 +225,39 @@ impl Default for Config {
     }
 }
 
+/// One root element, `<planet>`: serde reads the children of whatever root it finds and stops at its end, so a
+/// misnamed root or a second one would otherwise pass silently.
+fn check_root(text: &str, path: &str) -> Result<(), ConfigError> {
+    let error = |message: String| ConfigError::Xml {
+        path: path.to_string(),
+        message,
+    };
+    let mut depth = 0usize;
+    let mut roots = 0usize;
+    for event in xml::reader::EventReader::new(text.as_bytes()) {
+        match event.map_err(|e| error(e.to_string()))? {
+            xml::reader::XmlEvent::StartElement { name, .. } => {
+                if depth == 0 {
+                    roots += 1;
+                    if name.local_name != "planet" {
+                        return Err(error(format!(
+                            "the root element is <{}>; it must be <planet>",
+                            name.local_name
+                        )));
+                    }
+                    if roots > 1 {
+                        return Err(error("a second <planet> after the first one's end".into()));
+                    }
+                }
+                depth += 1;
+            }
+            xml::reader::XmlEvent::EndElement { .. } => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 // The file's shape. Every value is read as text first so that `1024.0f` and `>false` can be handled and a bad
 // value reported with its element name.
 #[derive(Deserialize, Default)]
@@ -461,6 +494,7 @@ impl Config {
 
     /// Parses configuration XML; `path` names the source in errors.
     pub fn parse(text: &str, path: &str) -> Result<Self, ConfigError> {
+        check_root(text, path)?;
         let raw: RawFile = serde_xml_rs::from_str(text).map_err(|e| {
             let message = e.to_string();
             match message.strip_prefix("Custom: unknown field ") {

@@ -261,3 +261,20 @@ fn the_drainage_model_brings_its_own_defaults_and_explicit_values_still_win() {
     assert_eq!(c.planet.detail_amplitude, 8.0);
     assert_eq!(c.river.samples_per_vertex_spacing, 0);
 }
+
+#[test]
+fn the_root_must_be_one_planet_element() {
+    for (xml, expected) in [
+        ("<world></world>", "must be <planet>"),
+        ("<planet></planet><planet></planet>", "a second <planet>"),
+        ("<planet>", "malformed"),
+    ] {
+        let message = error_of(xml);
+        assert!(message.contains(expected), "{xml}: {message}");
+    }
+    Config::parse(
+        "<?xml version=\"1.0\"?>\n<!-- a comment -->\n<planet></planet>",
+        "t.xml",
+    )
+    .unwrap();
+}
