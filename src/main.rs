@@ -71,7 +71,7 @@ fn main() -> ExitCode {
                 frame_flights: &frame_flight,
                 commands: &commands,
             };
-            let md = bench::report::results_markdown(&inputs)?;
+            let md = bench::report::results_markdown(&inputs).map_err(input_error)?;
             riverplanet::export::files::write_bytes(&out, md.as_bytes())
                 .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", out.display()))
         })()),
@@ -118,15 +118,27 @@ fn finish(result: anyhow::Result<()>) -> ExitCode {
     }
 }
 
+/// A report that cannot be read, or is not the command's it was given as, is a usage error; drawing failures are not.
+fn input_error(e: bench::plot::PlotError) -> anyhow::Error {
+    match e {
+        bench::plot::PlotError::Read { .. } | bench::plot::PlotError::Format { .. } => {
+            usage(e.to_string())
+        }
+        e => e.into(),
+    }
+}
+
 /// Figures 9.1-9.8 from the flight reports, printing the PNGs written.
 fn plot(
     flight: &std::path::Path,
     stress: Option<&std::path::Path>,
     out: &std::path::Path,
 ) -> anyhow::Result<()> {
-    let mut names = bench::plot::flight_figures(flight, out, "", false)?;
+    let mut names = bench::plot::flight_figures(flight, out, "", false).map_err(input_error)?;
     if let Some(stress) = stress {
-        names.extend(bench::plot::flight_figures(stress, out, "stress_", true)?);
+        names.extend(
+            bench::plot::flight_figures(stress, out, "stress_", true).map_err(input_error)?,
+        );
     }
     for n in names {
         println!("{}", out.join(n).with_extension("png").display());

@@ -529,3 +529,50 @@ fn report_names_a_missing_commands_file() {
     assert!(!dir.join("results.md").exists(), "a report was written");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn report_and_plot_name_a_report_of_the_wrong_command() {
+    let dir = temp_dir("wrong-report");
+    let flight = dir.join("flight.json");
+    std::fs::write(&flight, r#"{"frames": [], "summary": {}}"#).unwrap();
+    let kernel = dir.join("kernel.json");
+    std::fs::write(&kernel, r#"{"variants": {}}"#).unwrap();
+    let commands = dir.join("commands.txt");
+    std::fs::write(&commands, "").unwrap();
+    let run = riverplanet()
+        .args(["report", "--kernel"])
+        .arg(&flight)
+        .arg("--kernel-stress")
+        .arg(&kernel)
+        .arg("--flight")
+        .arg(&flight)
+        .arg("--flight-stress")
+        .arg(&flight)
+        .arg("--commands")
+        .arg(&commands)
+        .arg("--out")
+        .arg(dir.join("results.md"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("flight.json") && stderr.contains("`bench kernel`"),
+        "{stderr}"
+    );
+    assert!(!dir.join("results.md").exists());
+    let run = riverplanet()
+        .args(["plot", "--flight"])
+        .arg(&kernel)
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("kernel.json") && stderr.contains("`bench flight`"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -10,8 +10,12 @@ use serde_json::Value;
 pub enum PlotError {
     #[error("cannot read {path}: {message}")]
     Read { path: String, message: String },
-    #[error("{path} is not a `bench flight` report: {message}")]
-    Format { path: String, message: String },
+    #[error("{path} is not a `{expected}` report: {message}")]
+    Format {
+        path: String,
+        expected: &'static str,
+        message: String,
+    },
     #[error("cannot draw {path}: {message}")]
     Draw { path: String, message: String },
     #[error("no font for the plots: {0} (install fonts-dejavu-core)")]
@@ -116,20 +120,25 @@ pub fn line_chart(
     crate::export::files::save_image(&image, &base.with_extension("png")).map_err(|e| draw_err(&e))
 }
 
-fn read(path: &Path) -> Result<Value, PlotError> {
+/// The JSON report at `path`, which must be one of `command`'s: it has the top-level `key` (a report of another
+/// command would otherwise give empty figures or NaN tables).
+pub(super) fn read_report(
+    path: &Path,
+    command: &'static str,
+    key: &str,
+) -> Result<Value, PlotError> {
+    let format = |message: String| PlotError::Format {
+        path: path.display().to_string(),
+        expected: command,
+        message,
+    };
     let text = std::fs::read_to_string(path).map_err(|e| PlotError::Read {
         path: path.display().to_string(),
         message: e.to_string(),
     })?;
-    let value: Value = serde_json::from_str(&text).map_err(|e| PlotError::Format {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    if !value["frames"].is_array() {
-        return Err(PlotError::Format {
-            path: path.display().to_string(),
-            message: "no `frames` array".into(),
-        });
+    let value: Value = serde_json::from_str(&text).map_err(|e| format(e.to_string()))?;
+    if value.get(key).is_none() {
+        return Err(format(format!("it has no `{key}`")));
     }
     Ok(value)
 }
@@ -153,7 +162,7 @@ pub fn flight_figures(
     prefix: &str,
     stress: bool,
 ) -> Result<Vec<String>, PlotError> {
-    let value = read(report)?;
+    let value = read_report(report, "bench flight", "frames")?;
     let frames = value["frames"].as_array().cloned().unwrap_or_default();
     std::fs::create_dir_all(out).map_err(|e| PlotError::Draw {
         path: out.display().to_string(),

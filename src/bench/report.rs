@@ -5,18 +5,7 @@ use std::{fmt::Write as _, path::Path};
 
 use serde_json::Value;
 
-use super::plot::PlotError;
-
-fn read(path: &Path) -> Result<Value, PlotError> {
-    let text = std::fs::read_to_string(path).map_err(|e| PlotError::Read {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    serde_json::from_str(&text).map_err(|e| PlotError::Format {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })
-}
+use super::plot::{read_report, PlotError};
 
 fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
@@ -41,10 +30,10 @@ pub struct ReportInputs<'a> {
 
 /// Renders docs/results.md.
 pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
-    let k = read(inputs.kernel)?;
-    let ks = read(inputs.kernel_stress)?;
-    let fl = read(inputs.flight)?;
-    let fs = read(inputs.flight_stress)?;
+    let k = read_report(inputs.kernel, "bench kernel", "variants")?;
+    let ks = read_report(inputs.kernel_stress, "bench kernel", "variants")?;
+    let fl = read_report(inputs.flight, "bench flight", "summary")?;
+    let fs = read_report(inputs.flight_stress, "bench flight", "summary")?;
     let mut md = String::new();
     let w = &mut md;
     let threads = &k["threads"];
@@ -179,7 +168,10 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         f(&ks["relative_diff"]),
     );
     if let Some(path) = inputs.kernel_reuse {
-        reuse_section(w, &read(path)?);
+        reuse_section(
+            w,
+            &read_report(path, "bench kernel --parent-reuse", "from_scratch")?,
+        );
     }
     for (title, r, prefix) in [
         ("The approach", &fl, ""),
@@ -267,7 +259,7 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         }
     }
     if let Some(long) = inputs.long_flight {
-        let l = read(long)?;
+        let l = read_report(long, "bench flight", "summary")?;
         let s = &l["summary"];
         let _ = writeln!(
             w,
@@ -292,7 +284,7 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
              |---|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
         for path in inputs.descents {
-            let d = read(path)?;
+            let d = read_report(path, "bench flight", "summary")?;
             let s = &d["summary"];
             let _ =
                 writeln!(
@@ -342,7 +334,7 @@ fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), Plo
          |---|---|---|---|---|---|---|---|"
     );
     for path in paths {
-        let d = read(path)?;
+        let d = read_report(path, "bench flight", "summary")?;
         let s = &d["summary"];
         let _ = writeln!(
             w,
