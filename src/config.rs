@@ -48,7 +48,8 @@ pub struct PlanetConfig {
     /// `-1` in the file: pick a seed at start (logged). Resolved by [`Config::resolve_seed`].
     pub master_seed: i64,
     pub continents_from_file: bool,
-    /// Image read when `continents_from_file` is true (equirectangular, land bright / sea dark).
+    /// Image read when `continents_from_file` is true (equirectangular, land bright / sea dark); in a file,
+    /// relative to the file's folder (the default, config/continents.png, to the working folder).
     pub continents_image: String,
     /// Mountains (3x3 masks) seeded per continent (4.2).
     pub mountains_per_continent: u32,
@@ -572,9 +573,15 @@ impl Config {
                 &p.continents_from_file,
                 dp.continents_from_file,
             )?,
+            // A path written in the file is relative to the file's folder, so the file works from any folder.
             continents_image: p
                 .continents_image
-                .map(|s| s.trim().to_string())
+                .map(|s| {
+                    let parent = std::path::Path::new(path)
+                        .parent()
+                        .unwrap_or(std::path::Path::new(""));
+                    parent.join(s.trim()).to_string_lossy().into_owned()
+                })
                 .unwrap_or_else(|| dp.continents_image.clone()),
             mountains_per_continent: r.u32(
                 "mountains-per-continent",
@@ -793,11 +800,39 @@ impl Config {
                 ),
             ));
         }
-        Ok(Self {
+        let config = Self {
             planet,
             river,
             rendering,
-        })
+        };
+        if config.base_level().is_none() {
+            return Err(r.error(
+                "base-resolution",
+                &config.planet.base_resolution.to_string(),
+                config.base_resolution_rule(),
+            ));
+        }
+        Ok(config)
+    }
+
+    /// The quadtree level whose whole-face lattice the base heightmap is: its cells per face edge are a patch's
+    /// (`vertices - 1`) times 2^level, for a level down to `max-level-of-detail`; `None` if there is none.
+    pub fn base_level(&self) -> Option<u32> {
+        let cells = self.planet.base_resolution - 1;
+        (0..=self.rendering.max_level_of_detail)
+            .find(|l| (self.rendering.vertices - 1) << l == cells)
+    }
+
+    /// What `base-resolution` must be, with the valid values (up to level 6) for these vertices.
+    pub fn base_resolution_rule(&self) -> String {
+        let (n, max) = (self.rendering.vertices, self.rendering.max_level_of_detail);
+        let valid: Vec<String> = (0..=max.min(6))
+            .map(|l| (((n - 1) << l) + 1).to_string())
+            .collect();
+        format!(
+            "must be (vertices - 1) x 2^b + 1 for some b <= max-level-of-detail {max} (with vertices {n}: {})",
+            valid.join(", ")
+        )
     }
 
     /// The seed to use: the configured one, or for `-1` a fresh one from the clock (logged so a run can be

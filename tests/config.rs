@@ -278,3 +278,39 @@ fn the_root_must_be_one_planet_element() {
     )
     .unwrap();
 }
+
+#[test]
+fn a_base_resolution_that_no_level_holds_is_refused_by_the_configuration() {
+    // What `generate` used to refuse only after `config` had accepted it.
+    for (section, element, value) in [
+        ("rendering-attributes", "max-level-of-detail", "0"),
+        ("rendering-attributes", "max-level-of-detail", "1"),
+        ("planet-attributes", "base-resolution", "9"),
+    ] {
+        let message = error_of(&with(section, element, value));
+        assert!(
+            message.contains("<base-resolution>") && message.contains("(vertices - 1) x 2^b + 1"),
+            "{element} {value}: {message}"
+        );
+    }
+    let ok = with("rendering-attributes", "max-level-of-detail", "2");
+    assert_eq!(Config::parse(&ok, "t.xml").unwrap().base_level(), Some(2));
+}
+
+#[test]
+fn a_continents_image_named_in_a_file_is_found_beside_the_file() {
+    let text = with("planet-attributes", "continents-image", "continents.png");
+    let c = Config::parse(&text, "/somewhere/config/mine.xml").unwrap();
+    assert_eq!(
+        c.planet.continents_image,
+        "/somewhere/config/continents.png"
+    );
+    let absolute = with("planet-attributes", "continents-image", "/data/earth.png");
+    assert_eq!(
+        Config::parse(&absolute, "/somewhere/mine.xml")
+            .unwrap()
+            .planet
+            .continents_image,
+        "/data/earth.png"
+    );
+}

@@ -50,16 +50,8 @@ pub fn lon_lat(p: DVec3) -> (f64, f64) {
 pub enum PlanetError {
     #[error(transparent)]
     Continents(#[from] ContinentError),
-    #[error(
-        "base-resolution {base} must be (vertices - 1) x 2^b + 1 for some b <= max-level-of-detail {max} \
-         (with vertices {vertices}: {valid})"
-    )]
-    BaseResolution {
-        base: u32,
-        vertices: u32,
-        max: u32,
-        valid: String,
-    },
+    #[error("base-resolution {base} {rule}")]
+    BaseResolution { base: u32, rule: String },
 }
 
 /// What `generate` reports.
@@ -125,16 +117,11 @@ impl Planet {
         let r = &config.rendering;
         let cells_per_patch = r.vertices - 1;
         let base_cells = p.base_resolution - 1;
-        let base_level = (0..=r.max_level_of_detail)
-            .find(|l| cells_per_patch << l == base_cells)
+        let base_level = config
+            .base_level()
             .ok_or_else(|| PlanetError::BaseResolution {
                 base: p.base_resolution,
-                vertices: r.vertices,
-                max: r.max_level_of_detail,
-                valid: (0..=r.max_level_of_detail.min(6))
-                    .map(|l| ((cells_per_patch << l) + 1).to_string())
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                rule: config.base_resolution_rule(),
             })?;
         let mut timings = std::collections::BTreeMap::<String, f64>::new();
         let mut time = |stage: &str, since: Instant| {
