@@ -6,6 +6,16 @@ fn riverplanet() -> Command {
     Command::new(env!("CARGO_BIN_EXE_riverplanet"))
 }
 
+/// Asserts that `run` failed with exit code `code`, without a panic, and that its message names every culprit.
+fn assert_refused(run: &std::process::Output, code: i32, culprits: &[&str]) {
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(code), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for culprit in culprits {
+        assert!(stderr.contains(culprit), "no '{culprit}' in: {stderr}");
+    }
+}
+
 fn temp_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("riverplanet-cli-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -493,13 +503,7 @@ fn the_viewer_refuses_a_camera_inside_the_planet_or_looking_at_itself_before_ope
             .env_remove("WAYLAND_DISPLAY")
             .output()
             .unwrap();
-        let stderr = String::from_utf8_lossy(&run.stderr);
-        assert!(
-            !run.status.success(),
-            "accepted --eye {eye} --look-at {look_at}"
-        );
-        assert!(stderr.contains(expected), "{stderr}");
-        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert_refused(&run, 2, &[expected]);
     }
 }
 
@@ -523,9 +527,7 @@ fn report_names_a_missing_commands_file() {
         .arg(dir.join("results.md"))
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("--commands"), "{stderr}");
+    assert_refused(&run, 2, &["--commands"]);
     assert!(!dir.join("results.md").exists(), "a report was written");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -554,12 +556,7 @@ fn report_and_plot_name_a_report_of_the_wrong_command() {
         .arg(dir.join("results.md"))
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(2), "{stderr}");
-    assert!(
-        stderr.contains("flight.json") && stderr.contains("`bench kernel`"),
-        "{stderr}"
-    );
+    assert_refused(&run, 2, &["flight.json", "`bench kernel`"]);
     assert!(!dir.join("results.md").exists());
     let run = riverplanet()
         .args(["plot", "--flight"])
@@ -568,11 +565,6 @@ fn report_and_plot_name_a_report_of_the_wrong_command() {
         .arg(&dir)
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(2), "{stderr}");
-    assert!(
-        stderr.contains("kernel.json") && stderr.contains("`bench flight`"),
-        "{stderr}"
-    );
+    assert_refused(&run, 2, &["kernel.json", "`bench flight`"]);
     std::fs::remove_dir_all(&dir).ok();
 }

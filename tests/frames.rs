@@ -33,16 +33,12 @@ fn a_flight_keeps_two_frames_in_flight_and_passes_synchronization_validation() {
     let mut layout = vk::ImageLayout::UNDEFINED;
     let mut timed = Vec::new();
     for frame in 0..frames {
-        let stats = renderer
-            .render(
-                &flight.camera(world, frame),
-                &target.target([0.0, 0.0, 0.0, 1.0]),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )
-            .unwrap();
-        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        let stats = common::render_frame(
+            &mut renderer,
+            &flight.camera(world, frame),
+            &target,
+            &mut layout,
+        );
         // The CPU never waited for the previous frame before submitting this one, and returned before the GPU
         // finished this one.
         assert!(
@@ -79,16 +75,12 @@ fn one_frame_in_flight_waits_for_every_frame_as_the_thesis() {
     let flight = Flight::new(world, 10, 1.0, 16.0 / 9.0);
     let mut layout = vk::ImageLayout::UNDEFINED;
     for frame in 0..10 {
-        let stats = renderer
-            .render(
-                &flight.camera(world, frame),
-                &target.target([0.0, 0.0, 0.0, 1.0]),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )
-            .unwrap();
-        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        let stats = common::render_frame(
+            &mut renderer,
+            &flight.camera(world, frame),
+            &target,
+            &mut layout,
+        );
         assert_eq!(stats.synchronized_frame + 1, stats.frame);
     }
     assert!(renderer.set_frames_in_flight(4).is_err(), "at most three");

@@ -134,16 +134,12 @@ fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
     let mut layout = vk::ImageLayout::UNDEFINED;
     let mut evicted = 0;
     for frame in 0..frames {
-        let stats = renderer
-            .render(
-                &flight.camera(world, frame),
-                &target.target([0.0, 0.0, 0.0, 1.0]),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )
-            .unwrap();
-        layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+        let stats = common::render_frame(
+            &mut renderer,
+            &flight.camera(world, frame),
+            &target,
+            &mut layout,
+        );
         evicted += stats.evicted_patches;
         assert!(
             stats.resident_patches <= 96,

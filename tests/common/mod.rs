@@ -7,11 +7,12 @@
 use std::sync::OnceLock;
 
 use riverplanet::{
-    gpu::{Context, ContextOptions},
+    gpu::{vk, Context, ContextOptions},
     render::{
-        target::{COLOR_FORMAT, DEPTH_FORMAT},
-        Renderer,
+        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        FrameStats, Renderer,
     },
+    runtime::camera::Camera,
     world::World,
 };
 
@@ -79,4 +80,25 @@ pub fn renderer<'a>(ctx: &'a Context, world: &'a World) -> Renderer<'a> {
         DEPTH_FORMAT,
     )
     .unwrap()
+}
+
+/// Renders one frame of `camera` into `target` (cleared to black), its colour image in `*layout` before and in
+/// COLOR_ATTACHMENT_OPTIMAL after, without waiting for it.
+pub fn render_frame(
+    renderer: &mut Renderer,
+    camera: &Camera,
+    target: &Offscreen,
+    layout: &mut vk::ImageLayout,
+) -> FrameStats {
+    let stats = renderer
+        .render(
+            camera,
+            &target.target([0.0, 0.0, 0.0, 1.0]),
+            (*layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+            &[],
+            &[],
+        )
+        .unwrap();
+    *layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+    stats
 }
