@@ -251,10 +251,18 @@ fn unreadable_or_wrong_sized_images_are_clear_errors() {
     let garbage = dir.join("garbage.png");
     std::fs::write(&garbage, b"not a png").unwrap();
     let missing = dir.join("missing.png");
+    let sea = dir.join("sea.png");
+    image::GrayImage::new(64, 32).save(&sea).unwrap();
+    let land = dir.join("land.png");
+    image::GrayImage::from_pixel(64, 32, image::Luma([255]))
+        .save(&land)
+        .unwrap();
     for (path, expect) in [
         (&square, "twice as wide as high"),
         (&garbage, "cannot read"),
         (&missing, "cannot read"),
+        (&sea, "is all sea"),
+        (&land, "is all land"),
     ] {
         let mut c = small_config(30.0);
         c.planet.continents_from_file = true;

@@ -26,6 +26,11 @@ pub enum ContinentError {
         width: u32,
         height: u32,
     },
+    #[error(
+        "continents image {path} is all {what}: land is brighter than middle grey, sea darker, and a planet needs \
+         both"
+    )]
+    Uniform { path: String, what: &'static str },
 }
 
 /// The Voronoi feature points of Section 4.1.
@@ -213,7 +218,13 @@ impl ContinentImage {
                 height,
             });
         }
-        let land = image.pixels().map(|p| p.0[0] > u16::MAX / 2).collect();
+        let land: Vec<bool> = image.pixels().map(|p| p.0[0] > u16::MAX / 2).collect();
+        if land.iter().all(|&l| l) || !land.iter().any(|&l| l) {
+            return Err(ContinentError::Uniform {
+                path: path.display().to_string(),
+                what: if land[0] { "land" } else { "sea" },
+            });
+        }
         Ok(Self {
             width,
             height,
