@@ -4,8 +4,8 @@
 //!
 //! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look, Shift faster; M water mode,
 //! F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
-//! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, P screenshot, Escape
-//! quit.
+//! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, H back to the start
+//! view, P screenshot, Escape quit.
 
 use std::{collections::HashSet, path::PathBuf, time::Instant};
 
@@ -395,6 +395,8 @@ impl App<'_> {
         };
         match code {
             KeyCode::Escape => event_loop.exit(),
+            // Home: back to the start view, wherever the flight went.
+            KeyCode::KeyH => self.camera = FlyCamera::new(self.options.eye, self.options.look_at),
             KeyCode::KeyM => renderer.water_mode = renderer.water_mode.next(),
             KeyCode::KeyF => renderer.wireframe_on = !renderer.wireframe_on,
             KeyCode::KeyL => {
