@@ -1,8 +1,10 @@
 //! One frame (docs/rendering.md): the streaming plan (level of detail, culling, which patches get data:
 //! `plan`), the new patches' data (base heights uploaded or refined, river data from one kernel dispatch:
-//! `upload`), then the terrain and water passes (`draw`), each timed.
+//! `upload`), then the terrain and water passes (`draw`), each timed; submitted without waiting, and what it leaves
+//! to read back taken in once the GPU has finished it (`inflight`).
 
 mod draw;
+mod inflight;
 mod plan;
 mod upload;
 
@@ -13,12 +15,14 @@ use serde::Serialize;
 
 use self::draw::FramePush;
 pub use self::draw::{DrawnVertex, PatchInstance, VertexCapture};
+pub use self::inflight::GpuTimes;
+use self::inflight::{InFlight, TIMESTAMP_SCOPES};
 use super::mesh::{patch_mesh, PatchMesh};
 use crate::{
     config::{Config, LodRule},
     gpu::{
         bindless::{Bindless, Slot},
-        frames::{Finished, FrameRing, FRAMES_IN_FLIGHT},
+        frames::{FrameRing, FRAMES_IN_FLIGHT},
         pipeline::{BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
         vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
     },
@@ -126,25 +130,6 @@ impl FrameStats {
     pub fn streamed(&self) -> bool {
         self.pending_patches == 0 && self.fallback_patches == 0 && self.new_patches == 0
     }
-}
-
-/// Timestamp scopes per frame: heights, kernel, terrain, water, with room to spare.
-const TIMESTAMP_SCOPES: u32 = 8;
-
-/// What a frame in flight leaves to read back once the GPU has finished it.
-struct InFlight {
-    frame: u64,
-    new_patches: usize,
-    ranges: Option<crate::refine::RefinedRanges>,
-    drawn: draw::Drawn,
-    camera: DVec3,
-}
-
-/// The GPU time per pass of one finished frame.
-#[derive(Clone, Debug)]
-pub struct GpuTimes {
-    pub frame: u64,
-    pub ms: BTreeMap<String, f64>,
 }
 
 fn ms_since(t: Instant) -> f64 {
@@ -478,66 +463,6 @@ impl<'w> Renderer<'w> {
                 self.bindless.capacity
             ))
         })
-    }
-
-    /// Sets how many frames may be in flight (1 to 3; 1 waits for every frame before the next, as the thesis's
-    /// renderer did). Waits for the frames in flight first.
-    pub fn set_frames_in_flight(&mut self, count: usize) -> Result<(), GpuError> {
-        self.finish()?;
-        let ring = FrameRing::new(self.ctx, count, TIMESTAMP_SCOPES, "frame")?;
-        std::mem::replace(&mut self.frames, ring).destroy(self.ctx);
-        Ok(())
-    }
-
-    /// How many frames may be in flight.
-    pub fn frames_in_flight(&self) -> usize {
-        self.frames.contexts()
-    }
-
-    /// Waits for every frame in flight and collects what they left: afterwards `last_capture`, the height ranges
-    /// and `take_gpu_times` hold everything rendered so far.
-    pub fn finish(&mut self) -> Result<(), GpuError> {
-        let finished = self.frames.drain(self.ctx)?;
-        self.collect(finished)
-    }
-
-    /// The GPU times of the frames finished since the last call, oldest first.
-    pub fn take_gpu_times(&mut self) -> Vec<GpuTimes> {
-        std::mem::take(&mut self.gpu_times)
-    }
-
-    /// Takes in what finished frames left: refined patches' height ranges (for culling), the vertex capture, and
-    /// GPU times (which also steer the generation budget).
-    fn collect(&mut self, finished: Vec<Finished<InFlight>>) -> Result<(), GpuError> {
-        let n = self.config.rendering.vertices;
-        for Finished {
-            timings, payload, ..
-        } in finished
-        {
-            if let Some(ranges) = payload.ranges {
-                for (patch, range) in ranges.read(self.ctx)? {
-                    self.cache.set_height_range(&patch, range);
-                }
-            }
-            if let Some(capture) = payload.drawn.read_capture(self.ctx, payload.camera, n) {
-                self.last_capture = Some(capture);
-            }
-            let mut ms = BTreeMap::new();
-            for scope in timings {
-                *ms.entry(scope.name).or_default() += scope.ms;
-            }
-            self.measure_generation(payload.new_patches, &ms);
-            self.synchronized_frame = self.synchronized_frame.max(payload.frame);
-            // Keep a bounded backlog for callers that never take them (the viewer reads FrameStats instead).
-            if self.gpu_times.len() >= 1024 {
-                self.gpu_times.remove(0);
-            }
-            self.gpu_times.push(GpuTimes {
-                frame: payload.frame,
-                ms,
-            });
-        }
-        Ok(())
     }
 
     /// Frees every GPU object of the renderer (after the device is idle).

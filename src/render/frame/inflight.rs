@@ -1,0 +1,93 @@
+//! Frames in flight (beyond the thesis, docs/rendering.md): what a submitted frame leaves to read back, and how the
+//! renderer takes it in when the GPU has finished the frame (its context comes round again, or `finish`).
+
+use std::collections::BTreeMap;
+
+use glam::DVec3;
+
+use super::{draw::Drawn, Renderer};
+use crate::gpu::{
+    frames::{Finished, FrameRing},
+    GpuError,
+};
+
+/// Timestamp scopes per frame: heights, kernel, terrain, water, with room to spare.
+pub(super) const TIMESTAMP_SCOPES: u32 = 8;
+
+/// What a frame in flight leaves to read back once the GPU has finished it.
+pub(super) struct InFlight {
+    pub(super) frame: u64,
+    pub(super) new_patches: usize,
+    pub(super) ranges: Option<crate::refine::RefinedRanges>,
+    pub(super) drawn: Drawn,
+    pub(super) camera: DVec3,
+}
+
+/// The GPU time per pass of one finished frame.
+#[derive(Clone, Debug)]
+pub struct GpuTimes {
+    pub frame: u64,
+    pub ms: BTreeMap<String, f64>,
+}
+
+impl Renderer<'_> {
+    /// Sets how many frames may be in flight (1 to 3; 1 waits for every frame before the next, as the thesis's
+    /// renderer did). Waits for the frames in flight first.
+    pub fn set_frames_in_flight(&mut self, count: usize) -> Result<(), GpuError> {
+        self.finish()?;
+        let ring = FrameRing::new(self.ctx, count, TIMESTAMP_SCOPES, "frame")?;
+        std::mem::replace(&mut self.frames, ring).destroy(self.ctx);
+        Ok(())
+    }
+
+    /// How many frames may be in flight.
+    pub fn frames_in_flight(&self) -> usize {
+        self.frames.contexts()
+    }
+
+    /// Waits for every frame in flight and collects what they left: afterwards `last_capture`, the height ranges
+    /// and `take_gpu_times` hold everything rendered so far.
+    pub fn finish(&mut self) -> Result<(), GpuError> {
+        let finished = self.frames.drain(self.ctx)?;
+        self.collect(finished)
+    }
+
+    /// The GPU times of the frames finished since the last call, oldest first.
+    pub fn take_gpu_times(&mut self) -> Vec<GpuTimes> {
+        std::mem::take(&mut self.gpu_times)
+    }
+
+    /// Takes in what finished frames left: refined patches' height ranges (for culling), the vertex capture, and
+    /// GPU times (which also steer the generation budget).
+    pub(super) fn collect(&mut self, finished: Vec<Finished<InFlight>>) -> Result<(), GpuError> {
+        let n = self.config.rendering.vertices;
+        for Finished {
+            timings, payload, ..
+        } in finished
+        {
+            if let Some(ranges) = payload.ranges {
+                for (patch, range) in ranges.read(self.ctx)? {
+                    self.cache.set_height_range(&patch, range);
+                }
+            }
+            if let Some(capture) = payload.drawn.read_capture(self.ctx, payload.camera, n) {
+                self.last_capture = Some(capture);
+            }
+            let mut ms = BTreeMap::new();
+            for scope in timings {
+                *ms.entry(scope.name).or_default() += scope.ms;
+            }
+            self.measure_generation(payload.new_patches, &ms);
+            self.synchronized_frame = self.synchronized_frame.max(payload.frame);
+            // Keep a bounded backlog for callers that never take them (the viewer reads FrameStats instead).
+            if self.gpu_times.len() >= 1024 {
+                self.gpu_times.remove(0);
+            }
+            self.gpu_times.push(GpuTimes {
+                frame: payload.frame,
+                ms,
+            });
+        }
+        Ok(())
+    }
+}
