@@ -27,16 +27,15 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Info { json } => info(&options, json),
         Command::Generate {
-            config,
+            planet,
             out,
-            seed,
             preview,
             equirect,
             level,
         } => finish(generate(
-            config.as_deref(),
+            planet.config.as_deref(),
             &out,
-            seed,
+            planet.seed,
             (preview, equirect),
             level,
         )),

@@ -40,16 +40,11 @@ pub enum Command {
     Config { file: PathBuf },
     /// Generate the planet: per-face heightmaps, statistics and (with --preview) an unfolded picture.
     Generate {
-        /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
-        /// planet with the drainage model].
-        #[arg(long)]
-        config: Option<PathBuf>,
+        #[command(flatten)]
+        planet: PlanetArgs,
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
-        /// Override master-seed.
-        #[arg(long)]
-        seed: Option<u32>,
         /// Also write DIR/preview.png, the six faces unfolded.
         #[arg(long)]
         preview: bool,
@@ -113,13 +108,8 @@ pub enum Command {
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
-    /// planet with the drainage model].
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Override master-seed.
-    #[arg(long)]
-    pub seed: Option<u32>,
+    #[command(flatten)]
+    pub planet: PlanetArgs,
     /// Camera position, world units with the planet centre at the origin.
     #[arg(long, value_parser = parse_vec3, default_value = "0,1200,3400", allow_hyphen_values = true)]
     pub eye: glam::DVec3,
@@ -159,12 +149,8 @@ pub struct RenderArgs {
 
 #[derive(clap::Args)]
 pub struct ViewArgs {
-    /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
-    /// planet with the drainage model].
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    #[arg(long)]
-    pub seed: Option<u32>,
+    #[command(flatten)]
+    pub planet: PlanetArgs,
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
     pub size: [u32; 2],
     /// Start position (default: the orbit preset).
@@ -181,7 +167,19 @@ pub struct ViewArgs {
     pub screenshot: Option<PathBuf>,
 }
 
-/// The planet a benchmark runs on.
+/// The planet a command makes.
+#[derive(clap::Args)]
+pub struct PlanetArgs {
+    /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's
+    /// planet with the drainage model].
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Override master-seed.
+    #[arg(long)]
+    pub seed: Option<u32>,
+}
+
+/// The planet a benchmark runs on (seed 1 unless given, so runs compare).
 #[derive(clap::Args)]
 pub struct BenchPlanet {
     /// Configuration file [default: config/planet.xml if it exists, else the built-in default: Appendix A's

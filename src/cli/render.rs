@@ -6,7 +6,7 @@ use super::{RenderArgs, ViewArgs};
 use crate::{check_output, load_config, planet_seed, usage};
 
 pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
-    let (config, _) = load_config(args.config.as_deref())?;
+    let (config, _) = load_config(args.planet.config.as_deref())?;
     check_output("--out", &args.out, true)?;
     if args.preset.is_none() {
         check_camera(args.eye, args.look_at, &config)?;
@@ -17,7 +17,7 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
             args.fov
         )));
     }
-    let seed = planet_seed(args.seed, &config);
+    let seed = planet_seed(args.planet.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.preset {
         Some(preset) => riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
@@ -111,14 +111,14 @@ fn check_camera(
 }
 
 pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
-    let (config, _) = load_config(args.config.as_deref())?;
+    let (config, _) = load_config(args.planet.config.as_deref())?;
     if let Some(path) = &args.screenshot {
         check_output("--screenshot", path, true)?;
     }
     if let Some(eye) = args.eye {
         check_camera(eye, args.look_at, &config)?;
     }
-    let seed = planet_seed(args.seed, &config);
+    let seed = planet_seed(args.planet.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.eye {
         Some(eye) => (eye, args.look_at),

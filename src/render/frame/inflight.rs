@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use glam::DVec3;
 
-use super::{draw::Drawn, Renderer};
+use super::{draw::Drawn, FrameStats, Renderer};
 use crate::gpu::{
     frames::{Finished, FrameRing},
     GpuError,
@@ -54,7 +54,15 @@ impl Renderer<'_> {
 
     /// The GPU times of the frames finished since the last call, oldest first.
     pub fn take_gpu_times(&mut self) -> Vec<GpuTimes> {
-        std::mem::take(&mut self.gpu_times)
+        self.gpu_times.drain(..).collect()
+    }
+
+    /// Puts the newest finished frame's GPU times into `stats`.
+    pub(super) fn report_latest_gpu_times(&self, stats: &mut FrameStats) {
+        if let Some(latest) = &self.latest_gpu_times {
+            stats.gpu_ms = latest.ms.clone();
+            stats.gpu_frame = latest.frame;
+        }
     }
 
     /// Takes in what finished frames left: refined patches' height ranges (for culling), the vertex capture, and
@@ -79,14 +87,16 @@ impl Renderer<'_> {
             }
             self.measure_generation(payload.new_patches, &ms);
             self.synchronized_frame = self.synchronized_frame.max(payload.frame);
-            // Keep a bounded backlog for callers that never take them (the viewer reads FrameStats instead).
-            if self.gpu_times.len() >= 1024 {
-                self.gpu_times.remove(0);
-            }
-            self.gpu_times.push(GpuTimes {
+            let times = GpuTimes {
                 frame: payload.frame,
                 ms,
-            });
+            };
+            self.latest_gpu_times = Some(times.clone());
+            // A bounded backlog for callers that never take them (the viewer reads FrameStats instead).
+            if self.gpu_times.len() >= 1024 {
+                self.gpu_times.pop_front();
+            }
+            self.gpu_times.push_back(times);
         }
         Ok(())
     }

@@ -156,8 +156,10 @@ pub struct Renderer<'w> {
     all_indices: std::ops::Range<u32>,
     cache: PatchCache,
     frames: FrameRing<InFlight>,
-    /// GPU times of finished frames not yet taken (`take_gpu_times`).
-    gpu_times: Vec<GpuTimes>,
+    /// GPU times of finished frames not yet taken (`take_gpu_times`), the newest 1024 at most.
+    gpu_times: std::collections::VecDeque<GpuTimes>,
+    /// The newest finished frame's GPU times, what `FrameStats::gpu_ms` reports.
+    latest_gpu_times: Option<GpuTimes>,
     /// The newest frame collected after the GPU finished it.
     synchronized_frame: u64,
     params: KernelParams,
@@ -287,7 +289,8 @@ impl<'w> Renderer<'w> {
             all_indices: 0..mesh.len() as u32,
             cache: PatchCache::new(capacity),
             frames,
-            gpu_times: Vec::new(),
+            gpu_times: Default::default(),
+            latest_gpu_times: None,
             synchronized_frame: 0,
             params: KernelParams::from_config(config),
             heights,
@@ -343,10 +346,7 @@ impl<'w> Renderer<'w> {
                 self.finish()?;
                 // The last frame's time to its completion on the GPU.
                 stats.frame_ms = ms_since(start);
-                if let Some(last) = self.gpu_times.last() {
-                    stats.gpu_ms = last.ms.clone();
-                    stats.gpu_frame = last.frame;
-                }
+                self.report_latest_gpu_times(&mut stats);
                 stats.frames_in_flight = 0;
                 return Ok((stats, frames));
             }
@@ -415,10 +415,7 @@ impl<'w> Renderer<'w> {
         self.frames.submit(rec, waits, signals, in_flight)?;
         cpu.insert("submit".to_string(), ms_since(t));
         stats.frames_in_flight = self.frames.in_flight(ctx)?;
-        if let Some(last) = self.gpu_times.last() {
-            stats.gpu_ms = last.ms.clone();
-            stats.gpu_frame = last.frame;
-        }
+        self.report_latest_gpu_times(&mut stats);
         stats.resident_patches = self.cache.len();
         stats.patch_texture_bytes = self.cache.bytes();
         stats.precomputed_height_bytes = self.planet.lattice.bytes();
