@@ -14,6 +14,10 @@ const STAGES: [(&str, shaderc::ShaderKind); 4] = [
 // Debian's glslang/SPIRV-Tools static archives are linked into this build script by the glslang-link crate.
 extern crate glslang_link;
 
+// The atmosphere's air, shared with the library (src/planet/air.rs), handed to the shaders as macros.
+#[path = "src/planet/air.rs"]
+mod air;
+
 fn main() {
     // Read at run time, not with env!(): a build-script binary cached by another checkout must not compile that
     // checkout's shaders.
@@ -21,6 +25,7 @@ fn main() {
     let glsl_dir = Path::new(&manifest_dir).join("glsl");
     let out_dir = env::var("OUT_DIR").expect("cargo sets OUT_DIR");
     println!("cargo:rerun-if-changed={}", glsl_dir.display());
+    println!("cargo:rerun-if-changed=src/planet/air.rs");
 
     let compiler = shaderc::Compiler::new().expect("shaderc compiler");
     let mut entries: Vec<_> = fs::read_dir(&glsl_dir)
@@ -80,6 +85,9 @@ fn compile_options(glsl_dir: &Path) -> shaderc::CompileOptions<'static> {
     options.set_target_spirv(shaderc::SpirvVersion::V1_6);
     options.set_optimization_level(shaderc::OptimizationLevel::Performance);
     options.set_warnings_as_errors();
+    for (name, value) in air_macros() {
+        options.add_macro_definition(name, Some(&value));
+    }
     let root = glsl_dir.to_path_buf();
     options.set_include_callback(move |requested, _kind, _from, _depth| {
         let path = root.join(requested);
@@ -92,4 +100,30 @@ fn compile_options(glsl_dir: &Path) -> shaderc::CompileOptions<'static> {
         })
     });
     options
+}
+
+/// The GLSL macros of `glsl/atmosphere.glsl`: the numbers of `air`, as float literals.
+fn air_macros() -> Vec<(&'static str, String)> {
+    let float = |x: f64| format!("{x:?}");
+    let [r, g, b] = air::RAYLEIGH_OPTICAL_DEPTH.map(float);
+    vec![
+        (
+            "RAYLEIGH_HEIGHT_FRACTION",
+            float(air::RAYLEIGH_HEIGHT_FRACTION),
+        ),
+        ("MIE_HEIGHT_RATIO", float(air::MIE_HEIGHT_RATIO)),
+        ("RAYLEIGH_OPTICAL_DEPTH", format!("vec3({r}, {g}, {b})")),
+        ("MIE_OPTICAL_DEPTH", float(air::MIE_OPTICAL_DEPTH)),
+        ("MIE_EXTINCTION_RATIO", float(air::MIE_EXTINCTION_RATIO)),
+        ("MIE_G", float(air::MIE_G)),
+        ("SUN_INTENSITY", float(air::SUN_INTENSITY)),
+        (
+            "TRANSMITTANCE_WIDTH",
+            float(air::TRANSMITTANCE_SIZE[0] as f64),
+        ),
+        (
+            "TRANSMITTANCE_HEIGHT",
+            float(air::TRANSMITTANCE_SIZE[1] as f64),
+        ),
+    ]
 }

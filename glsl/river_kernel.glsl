@@ -83,10 +83,13 @@ struct Accumulators {
     float inRiverSum;
     float inRiverWSum;
     float minDistance;
+    // Beyond the thesis: the unit directions (downstream) of the samples whose river covers the vertex, weighted
+    // as their river depth (the water's flow).
+    vec2 flowSum;
 };
 
 Accumulators initAccumulators() {
-    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38);
+    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -138,6 +141,8 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
             acc.inRiver = true;
             acc.inRiverSum += wRiver * factor * basinDepth;
             acc.inRiverWSum += wRiver;
+            // d / |d| without another square root: inverseScale x halfWidth = 1 / |d| (and d = 0 stays 0).
+            acc.flowSum += wRiver * (d * (s.inverseScale * s.halfWidth));
         }
         float signedDist = side > 0.0 ? -dist : dist;
         if (abs(signedDist) < abs(acc.minDistance)) acc.minDistance = signedDist;
@@ -148,11 +153,14 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
 void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
     vec4 heights = vec4(0.0, 1.0, params.seaLevel, params.influenceDistance);
     float riverWidth = 0.0;
+    vec2 flow = vec2(0.0);
     if (acc.weightSum > 0.0) {
+
         float height = acc.heightSum / acc.weightSum;
         float basin = acc.basinSum / acc.weightSum;
         riverWidth = acc.widthSum / acc.weightSum;
         if (acc.inRiver) {
+            flow = acc.flowSum / acc.inRiverWSum;
             float inRiverBasin = acc.inRiverSum / acc.inRiverWSum;
             float heightOffset = basin - params.basinWaterOffset;
                     heights = vec4(height + inRiverBasin, 0.0, max(params.seaLevel, height + heightOffset), acc.minDistance);
@@ -165,5 +173,5 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
         }
     }
     imageStore(riverImages[job.slot], ivec3(xy, 0), heights);
-    imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, 0.0, 0.0, 0.0));
+    imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, flow, 0.0));
 }

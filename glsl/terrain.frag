@@ -3,6 +3,7 @@
 // slopes, lit by the sun; rivers too thin for the mesh painted from the signed distance and width (8.4). The
 // water pass shades water by depth with a specular highlight.
 #include "terrain_common.glsl"
+#include "atmosphere.glsl"
 
 layout(constant_id = 0) const uint WATER_PASS = 0;
 
@@ -13,6 +14,11 @@ layout(location = 3) flat in int fRiverWater;
 layout(location = 4) flat in float fLevel;
 layout(location = 5) in vec3 fDirection;
 layout(location = 9) flat in float fSpacing;
+layout(location = 10) in vec3 fInscatterRayleigh;
+layout(location = 11) in vec3 fInscatterMie;
+layout(location = 12) in vec3 fTransmittance;
+layout(location = 13) in vec3 fSunlight;
+layout(location = 14) in vec3 fFlow;
 
 layout(location = 0) out vec4 outColor;
 
@@ -60,45 +66,119 @@ vec3 levelColour(float level) {
     return palette[int(level) % 8];
 }
 
+// Beyond the thesis (water that flows): ripples of two octaves of value noise, `q` in ripple sizes, carried
+// along `velocity` (ripple sizes per second) and restarted every FLOW_PERIOD seconds in two phases half a period
+// apart that cross-fade (flow mapping, Vlachos 2010), so that a flow varying in space never stretches them.
+const float FLOW_PERIOD = 2.0;
+
+float rippleHeight(vec3 q) { return noise(q) + 0.5 * noise(q * 2.3 + 11.0); }
+
+vec3 rippleGradient(vec3 q) {
+    const float e = 0.25;
+    float h = rippleHeight(q);
+    return vec3(rippleHeight(q + vec3(e, 0.0, 0.0)) - h, rippleHeight(q + vec3(0.0, e, 0.0)) - h,
+                rippleHeight(q + vec3(0.0, 0.0, e)) - h) / e;
+}
+
+// The two phases' positions and the first one's weight.
+void flowPhases(vec3 q, vec3 velocity, out vec3 q0, out vec3 q1, out float w0) {
+    float t = frame.extra.y / FLOW_PERIOD;
+    float phase0 = fract(t);
+    float phase1 = fract(t + 0.5);
+    w0 = 1.0 - abs(1.0 - 2.0 * phase0);
+    q0 = q - velocity * (phase0 * FLOW_PERIOD);
+    q1 = q - velocity * (phase1 * FLOW_PERIOD) + vec3(0.41, 0.27, 0.63);
+}
+
+// The rippled water normal around `up`, the ripples weighted by `strength`.
+vec3 flowingNormal(vec3 up, vec3 q0, vec3 q1, float w0, float strength) {
+    vec3 g = w0 * rippleGradient(q0) + (1.0 - w0) * rippleGradient(q1);
+    return normalize(up - strength * (g - up * dot(g, up)));
+}
+
+// The air between the eye and the surface: what it lets through plus what it scatters towards the eye
+// (atmosphere.glsl); without an atmosphere, a constant haze that grows with distance.
+vec3 throughAir(vec3 colour) {
+    if (!atmosphereOn()) {
+        return mix(colour, vec3(0.55, 0.65, 0.8), clamp(length(fPosition) / (frame.planet.x * 6.0), 0.0, 0.35));
+    }
+    float c = dot(normalize(fPosition), normalize(frame.sun.xyz));
+    return colour * fTransmittance + toneMap(inscattered(fInscatterRayleigh, fInscatterMie, c));
+}
+
+// Beyond the thesis: the lit colour and opacity of water, flowing unless still (the thesis's, Section 8.4): the
+// rippled normal, foam at the bank (rivers) or the shore (the sea) broken up by the moving ripples, the reflected
+// sky, the sun's glint. `q`: the fragment in ripple sizes, `visible`: how much the ripples show (both from
+// rippleSpace, in uniform control flow); `depth`: the water above the terrain.
+vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 view, vec3 sun) {
+    vec3 wind = cross(up, vec3(0.0, 1.0, 0.0));
+    vec3 velocity = river ? fFlow * 0.8 : wind * 0.15;
+    vec3 q0, q1;
+    float w0;
+    flowPhases(q, velocity, q0, q1, w0);
+    vec3 surface = visible > 0.0 ? flowingNormal(up, q0, q1, w0, 0.35 * visible) : up;
+    float edge = stillWater() ? 0.0
+               : river ? smoothstep(0.7, 1.0, abs(fRiver.z) / fRiver.w)
+                       : 1.0 - smoothstep(0.0, 0.25 * frame.extra.z, depth);
+    float foam = edge * smoothstep(0.55, 0.8, w0 * noise(q0 * 2.0) + (1.0 - w0) * noise(q1 * 2.0));
+    vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
+    colour = mix(colour, vec3(0.92, 0.95, 0.97), foam * 0.85);
+    vec3 diffuse = max(dot(surface, sun), 0.0) * fSunlight;
+    vec3 reflected = reflect(-sun, surface);
+    float specular = pow(max(dot(reflected, view), 0.0), 80.0) * step(0.0, dot(up, sun)) * (1.0 - foam);
+    float fresnel = 0.02 + 0.98 * pow(1.0 - max(dot(surface, view), 0.0), 5.0);
+    // The sky it reflects, from the horizon's colour to the zenith's (what makes ripples show at grazing views).
+    float reflectedUp = clamp(dot(reflect(-view, surface), up), 0.0, 1.0);
+    vec3 sky = mix(vec3(0.62, 0.72, 0.84), vec3(0.16, 0.28, 0.55), sqrt(reflectedUp)) * (1.0 - foam);
+    colour = mix(colour * (0.25 + 0.75 * diffuse), sky, fresnel * 0.8) + vec3(1.0, 0.95, 0.85) * fSunlight * specular * 0.8;
+    float alpha = max(clamp(0.55 + depth / frame.extra.z * 0.3, 0.55, 0.92), foam);
+    return vec4(colour, alpha);
+}
+
+// The fragment in ripple sizes (rivers: the river's half width; the sea: a unit of colour band, extra.z) and how
+// much ripples show: they fade where one is smaller than a pixel, and still water has none. Takes derivatives.
+vec3 rippleSpace(bool river, out float visible) {
+    float size = river ? max(fRiver.w, 0.02) : frame.extra.z;
+    vec3 q = fDirection * (frame.planet.x / size);
+    visible = stillWater() ? 0.0 : 1.0 - smoothstep(0.4, 1.2, length(fwidth(q)));
+    return q;
+}
+
 void main() {
     vec3 sun = normalize(frame.sun.xyz);
     vec3 up = normalize(fDirection);
     vec3 view = normalize(-fPosition);
     if (WATER_PASS == 1) {
+        bool river = fRiverWater == 1;
+        float visible;
+        vec3 q = rippleSpace(river, visible);
         // River water covers the basin only: a triangle reaching past the banks is cut at the river's width.
-        if (fRiverWater == 1 && abs(fRiver.z) > fRiver.w) discard;
-        float depth = max(fRiver.y - fRiver.x, 0.0);
-        vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
-        float diffuse = max(dot(up, sun), 0.0);
-        vec3 reflected = reflect(-sun, up);
-        float specular = pow(max(dot(reflected, view), 0.0), 80.0) * step(0.0, dot(up, sun));
-        float fresnel = 0.02 + 0.98 * pow(1.0 - max(dot(up, view), 0.0), 5.0);
-        colour = colour * (0.25 + 0.75 * diffuse) + vec3(1.0, 0.95, 0.85) * specular * 0.8 + vec3(0.5, 0.6, 0.7) * fresnel * 0.3;
-        float alpha = clamp(0.55 + depth / frame.extra.z * 0.3, 0.55, 0.92);
-        outColor = vec4(colour, alpha);
+        if (river && abs(fRiver.z) > fRiver.w) discard;
+        vec4 water = waterSurface(river, max(fRiver.y - fRiver.x, 0.0), q, visible, up, view, sun);
+        outColor = vec4(atmosphereOn() ? throughAir(water.rgb) : water.rgb, water.a);
         return;
     }
+    float visible;
+    vec3 q = rippleSpace(true, visible);
+    float edge = fwidth(fRiver.z) + 1e-4;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // One octave of detail noise about a world unit across (two octaves cost lavapipe 15 ms a frame at 720p).
     float detail = noise(fDirection * frame.planet.x);
     vec3 albedo = terrainColour(fRiver.x, slope * 3.0, vec3(detail));
-    if (uint(frame.planet.w) == 1) albedo = mix(albedo, levelColour(fLevel), 0.6);
-    // Section 8.4: paint a river the mesh is too coarse to carve (vertices not closer than half its width, the
-    // thesis's rule, in `auto`), from the signed distance and width.
-    uint mode = uint(frame.planet.z);
-    bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
-    if (paint && fRiver.w > 0.0) {
-        float edge = fwidth(fRiver.z) + 1e-4;
-        float inside = 1.0 - smoothstep(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z));
-        vec3 paint = uint(frame.planet.w) == 2 ? vec3(0.9, 0.1, 0.1) : WATER_SHALLOW;
-        albedo = mix(albedo, paint, inside);
-    }
-    float diffuse = max(dot(normal, sun), 0.0);
+    if (viewMode() == 1) albedo = mix(albedo, levelColour(fLevel), 0.6);
+    vec3 diffuse = max(dot(normal, sun), 0.0) * fSunlight;
     float ambient = 0.18 + 0.12 * max(dot(up, sun) + 0.3, 0.0);
     vec3 colour = albedo * (ambient + 0.85 * diffuse);
-    // Aerial perspective: distant terrain fades towards the sky colour.
-    float distance = length(fPosition);
-    colour = mix(colour, vec3(0.55, 0.65, 0.8), clamp(distance / (frame.planet.x * 6.0), 0.0, 0.35));
-    outColor = vec4(colour, 1.0);
+    // Section 8.4: paint a river the mesh is too coarse to carve (vertices not closer than half its width, the
+    // thesis's rule, in `auto`), from the signed distance and width; as water half a colour band deep.
+    uint mode = waterMode();
+    bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
+    float inside = paint && fRiver.w > 0.0 ? 1.0 - smoothstep(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
+    if (inside > 0.0) {
+        vec3 water = viewMode() == 2 ? vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse)
+                                     : waterSurface(true, 0.5 * frame.extra.z, q, visible, up, view, sun).rgb;
+        colour = mix(colour, water, inside);
+    }
+    outColor = vec4(throughAir(colour), 1.0);
 }

@@ -15,6 +15,11 @@ layout(location = 5) in vec3 vDirection[];
 layout(location = 6) in vec2 vGrid[];
 layout(location = 7) flat in int vInstance[];
 layout(location = 8) flat in int vSkirt[];
+layout(location = 10) in vec3 vInscatterRayleigh[];
+layout(location = 11) in vec3 vInscatterMie[];
+layout(location = 12) in vec3 vTransmittance[];
+layout(location = 13) in vec3 vSunlight[];
+layout(location = 14) in vec3 vFlow[];
 
 layout(location = 0) out vec3 fPosition;
 layout(location = 1) out vec3 fNormal;
@@ -23,6 +28,11 @@ layout(location = 3) flat out int fRiverWater;
 layout(location = 4) flat out float fLevel;
 layout(location = 5) out vec3 fDirection;
 layout(location = 9) flat out float fSpacing;
+layout(location = 10) out vec3 fInscatterRayleigh;
+layout(location = 11) out vec3 fInscatterMie;
+layout(location = 12) out vec3 fTransmittance;
+layout(location = 13) out vec3 fSunlight;
+layout(location = 14) out vec3 fFlow;
 
 void main() {
     if (vSkirt[0] >= 0 || vSkirt[1] >= 0 || vSkirt[2] >= 0) return;
@@ -34,7 +44,7 @@ void main() {
 
     float spacing = p.centreDir.w;
     float seaLevel = frame.sun.w;
-    uint mode = uint(frame.planet.z);
+    uint mode = waterMode();
     bool inBasin = false;
     bool belowSea = false;
     float widest = 0.0;
@@ -59,6 +69,11 @@ void main() {
         fLevel = p.centreRel.w;
         fDirection = vDirection[k];
         fSpacing = spacing;
+        fInscatterRayleigh = vInscatterRayleigh[k];
+        fInscatterMie = vInscatterMie[k];
+        fTransmittance = vTransmittance[k];
+        fSunlight = vSunlight[k];
+        fFlow = vFlow[k];
         gl_Position = frame.viewProjection * vec4(position, 1.0);
         EmitVertex();
     }

@@ -2,6 +2,7 @@
 // Section 8.2: per vertex, the base height and the river data of the patch, blended by the lerp factor, projected
 // onto the sphere; normals from neighbouring heights; skirts below the patch edges close cracks between levels.
 #include "terrain_common.glsl"
+#include "atmosphere.glsl"
 
 layout(constant_id = 0) const uint WATER_PASS = 0;
 
@@ -17,6 +18,13 @@ layout(location = 6) out vec2 vGrid;        // (i, j) within the patch
 layout(location = 7) flat out int vInstance;
 layout(location = 8) flat out int vSkirt;   // -1 surface, 0-3 edge skirts, 4-5 midline skirts
 layout(location = 9) flat out float vSpacing;
+// The atmosphere between the camera and the vertex (atmosphere.glsl); the water pass uses the terrain vertex's (the
+// water lies a little higher: the difference does not show).
+layout(location = 10) out vec3 vInscatterRayleigh;
+layout(location = 11) out vec3 vInscatterMie;
+layout(location = 12) out vec3 vTransmittance;
+layout(location = 13) out vec3 vSunlight;   // the sunlight that reaches the vertex
+layout(location = 14) out vec3 vFlow;       // the river's flow: a tangent, unit length where the samples agree
 
 // Texture coordinates of a grid position in the base-height texture, which has a border of HEIGHT_BORDER points
 // (planet::detail::BORDER) on each side.
@@ -45,18 +53,19 @@ float baseAt(PatchInstance p, vec2 grid) {
     return textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
 }
 
-// River data at a grid position (layer 0: terrain height, lerp factor, water height, signed distance; and the
-// half width), blended by the morph factor into the parent's river data at the same place.
-vec4 riverAt(PatchInstance p, vec2 grid, float morph, out float halfWidth) {
+// River data at a grid position (layer 0: terrain height, lerp factor, water height, signed distance; layer 1: the
+// half width and the flow in the patch frame), blended by the morph factor into the parent's river data at the
+// same place.
+vec4 riverAt(PatchInstance p, vec2 grid, float morph, out vec3 widthFlow) {
     float n = frame.planet.y;
     vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, 0.0);
     vec4 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
-    halfWidth = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv + vec3(0, 0, 1), 0.0).r;
+    widthFlow = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv + vec3(0, 0, 1), 0.0).rgb;
     if (morph > 0.0 && p.slots.w >= 0) {
         vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, 0.0);
         river = mix(river, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
-        halfWidth = mix(halfWidth, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv + vec3(0, 0, 1), 0.0).r,
-                        morph);
+        widthFlow = mix(widthFlow,
+                        textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv + vec3(0, 0, 1), 0.0).rgb, morph);
     }
     return river;
 }
@@ -65,21 +74,23 @@ vec4 riverAt(PatchInstance p, vec2 grid, float morph, out float halfWidth) {
 float heightAt(PatchInstance p, vec2 grid, float morph) {
     float base = baseAt(p, grid);
     if (p.slots.y < 0) return base;
-    float halfWidth;
-    vec4 river = riverAt(p, grid, morph, halfWidth);
+    vec3 widthFlow;
+    vec4 river = riverAt(p, grid, morph, widthFlow);
     return mix(river.x, base, river.y);
 }
 
 // Terrain height, water height, signed distance and half width at a grid position, from the patch's (or its
-// stand-in's) textures.
-vec4 surfaceAt(PatchInstance p, vec2 grid, float morph) {
+// stand-in's) textures; `flow`: the water's flow in the patch frame.
+vec4 surfaceAt(PatchInstance p, vec2 grid, float morph, out vec2 flow) {
     float base = baseAt(p, grid);
+    flow = vec2(0.0);
     if (p.slots.y < 0) return vec4(base, frame.sun.w, 1e9, 0.0);
-    float halfWidth;
-    vec4 river = riverAt(p, grid, morph, halfWidth);
+    vec3 widthFlow;
+    vec4 river = riverAt(p, grid, morph, widthFlow);
+    flow = widthFlow.yz;
     // Section 8.2: blend the river terrain into the base terrain by the lerp factor.
     float height = mix(river.x, base, river.y);
-    return vec4(height, max(river.z, frame.sun.w), river.w, halfWidth);
+    return vec4(height, max(river.z, frame.sun.w), river.w, widthFlow.x);
 }
 
 // Beyond the thesis (CDLOD, Strugar 2009): how far a vertex has morphed towards its parent's mesh, from its
@@ -117,7 +128,8 @@ void main() {
     // base height, which neighbouring patches share bit for bit.
     float morph = morphFactor(p, length(positionAt(p, baseAt(p, grid), directionOffset(p, grid))));
     vec2 morphed = grid - mod(grid, 2.0) * morph;
-    vec4 surface = surfaceAt(p, morphed, morph);
+    vec2 flow;
+    vec4 surface = surfaceAt(p, morphed, morph, flow);
     vec3 offset = directionOffset(p, morphed);
     vec3 direction = normalize(p.centreDir.xyz + offset);
     float height = surface.x;
@@ -153,5 +165,19 @@ void main() {
     vRiverWater = 0;
     vLevel = p.centreRel.w;
     vSpacing = p.centreDir.w;
+    // The patch frame's axes are the face's u and v (the grid's i and j), taken into the tangent plane.
+    vec3 tangentU = normalize(p.axisU.xyz - direction * dot(p.axisU.xyz, direction));
+    vec3 tangentV = normalize(p.axisV.xyz - direction * dot(p.axisV.xyz, direction));
+    vFlow = flow.x * tangentU + flow.y * tangentV;
+    vInscatterRayleigh = vec3(0.0);
+    vInscatterMie = vec3(0.0);
+    vTransmittance = vec3(1.0);
+    vSunlight = vec3(1.0);
+    if (atmosphereOn()) {
+        Scattering s = airTo(position, height, direction, vSunlight);
+        vInscatterRayleigh = s.rayleigh;
+        vInscatterMie = s.mie;
+        vTransmittance = s.transmittance;
+    }
     gl_Position = frame.viewProjection * vec4(position, 1.0);
 }

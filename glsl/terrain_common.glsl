@@ -7,13 +7,21 @@ layout(push_constant) uniform FramePush {
     mat4 viewProjection;
     // xyz: unit direction towards the sun; w: sea level.
     vec4 sun;
-    // x: radius; y: vertices per patch edge; z: water mode (0 auto, 1 geometry, 2 painted); w: view (0 shaded,
-    // 1 level-of-detail colours, 2 painted rivers shown red).
+    // x: radius; y: vertices per patch edge; z: water mode (0 auto, 1 geometry, 2 painted) + 4 x view (0 shaded,
+    // 1 level-of-detail colours, 2 painted rivers shown red) + 16 if the water is still; w: the lowest height any
+    // terrain can have.
     vec4 planet;
-    // x: unused; y: time; z: height unit of the colour bands (max-mountain-height / 16,
-    // so that Appendix A's planet, whose mountains are 16 high, is coloured as before); w: 1 to capture vertices.
+    // x: the atmosphere's transmittance table slot, or -1 without atmosphere; y: time in seconds (the water's
+    // flow); z: height unit of the colour bands (max-mountain-height / 16, so that Appendix A's planet, whose
+    // mountains are 16 high, is coloured as before); w: 1 to capture vertices.
     vec4 extra;
+    // xyz: the camera from the planet's centre; w: atmosphere-height.
+    vec4 camera;
 } frame;
+
+uint waterMode() { return uint(frame.planet.z) & 3u; }
+uint viewMode() { return (uint(frame.planet.z) >> 2) & 3u; }
+bool stillWater() { return (uint(frame.planet.z) & 16u) != 0u; }
 
 const uint WATER_AUTO = 0;
 const uint WATER_GEOMETRY = 1;

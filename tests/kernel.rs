@@ -42,6 +42,36 @@ fn vertex_on_the_river_centre_gets_the_river_height() {
     assert!(t.min_distance.abs() < 1e-6);
 }
 
+/// Beyond the thesis: the flow is the samples' direction downstream, at unit length where they agree (a river
+/// whose derivative has length 3 flows at unit length too), and it bends with the river.
+#[test]
+fn the_flow_follows_the_river_downstream() {
+    let p = params();
+    let t = cpu::calculate_height([10.0, 17.0], &straight_river(), &p);
+    assert!(
+        (t.flow[0] - 1.0).abs() < 1e-6 && t.flow[1].abs() < 1e-6,
+        "{t:?}"
+    );
+    let fast: Vec<RiverSample> = (0..=192)
+        .map(|k| RiverSample::new([16.0, k as f32 / 6.0], [0.0, -3.0], 5.0, 4.0))
+        .collect();
+    let t = cpu::calculate_height([15.0, 10.0], &fast, &p);
+    assert!(
+        t.flow[0].abs() < 1e-6 && (t.flow[1] + 1.0).abs() < 1e-6,
+        "{t:?}"
+    );
+    // A right-angle bend: halfway between the two arms the flow points between them.
+    let bend: Vec<RiverSample> = straight_river()
+        .into_iter()
+        .filter(|s| s.position[0] <= 16.0)
+        .chain(
+            (1..=96).map(|k| RiverSample::new([16.0, 16.0 + k as f32 / 6.0], [0.0, 1.0], 5.0, 4.0)),
+        )
+        .collect();
+    let t = cpu::calculate_height([17.0, 15.0], &bend, &p);
+    assert!(t.flow[0] > 0.2 && t.flow[1] > 0.2, "{t:?}");
+}
+
 #[test]
 fn basin_rises_cubically_to_the_banks() {
     let samples = straight_river();
@@ -103,7 +133,8 @@ fn no_relevant_sample_keeps_the_base_terrain() {
                 lerp_factor: 1.0,
                 water_height: p.sea_level,
                 min_distance: p.influence_distance,
-                river_width: 0.0
+                river_width: 0.0,
+                flow: [0.0; 2],
             }
         );
     }

@@ -31,6 +31,13 @@ fn render(ctx: &Context, camera: &Camera, size: [u32; 2], water: WaterMode) -> i
     render_with(ctx, camera, size, |renderer| renderer.water_mode = water)
 }
 
+/// Renders with the default renderer and a black clear colour (space), with the atmosphere on or off.
+fn render_air(ctx: &Context, camera: &Camera, size: [u32; 2], on: bool) -> image::RgbaImage {
+    render_cleared(ctx, camera, size, [0.0, 0.0, 0.0, 1.0], |r| {
+        r.atmosphere_on = on
+    })
+}
+
 fn preset_camera(preset: Preset, aspect: f64) -> Camera {
     let (eye, target) = presets::camera(preset, world()).unwrap();
     let altitude = eye.length() - world().planet.radius;
@@ -174,16 +181,171 @@ fn render_with(
     size: [u32; 2],
     setup: impl Fn(&mut Renderer),
 ) -> image::RgbaImage {
+    render_cleared(ctx, camera, size, CLEAR, setup)
+}
+
+fn render_cleared(
+    ctx: &Context,
+    camera: &Camera,
+    size: [u32; 2],
+    clear: [f32; 4],
+    setup: impl Fn(&mut Renderer),
+) -> image::RgbaImage {
     let world = world();
     let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
     let mut renderer = common::renderer(ctx, world);
     setup(&mut renderer);
     let mut layout = vk::ImageLayout::UNDEFINED;
     renderer
-        .render_until_streamed(camera, &target.target(CLEAR), &mut layout, 100)
+        .render_until_streamed(camera, &target.target(clear), &mut layout, 100)
         .unwrap();
     let image = target.read(ctx).unwrap();
     renderer.destroy();
     target.destroy(ctx);
     image
+}
+
+fn brightness(p: &image::Rgba<u8>) -> f64 {
+    (p.0[0] as f64 + p.0[1] as f64 + p.0[2] as f64) / 3.0
+}
+
+/// Beyond the thesis: the atmosphere. From the ground the sky is blue and brightens towards the horizon, and
+/// distant terrain takes the colour of the air (aerial perspective) while the terrain at the camera's feet keeps
+/// its own; without the atmosphere the sky is the clear colour.
+#[test]
+fn the_sky_is_blue_from_the_ground_and_distant_land_fades_into_it() {
+    let Some(ctx) = common::gpu() else { return };
+    let size = [192, 108];
+    let camera = preset_camera(Preset::Ground, size[0] as f64 / size[1] as f64);
+    let on = render_air(ctx, &camera, size, true);
+    let off = render_air(ctx, &camera, size, false);
+    on.save(out_dir().join("air-ground-on.png")).unwrap();
+    off.save(out_dir().join("air-ground-off.png")).unwrap();
+    let (w, h) = on.dimensions();
+    let row = |image: &image::RgbaImage, y: u32| {
+        (0..w)
+            .map(|x| brightness(image.get_pixel(x, y)))
+            .sum::<f64>()
+            / w as f64
+    };
+    for x in 0..w {
+        let sky = on.get_pixel(x, 0).0;
+        assert!(
+            sky[2] > sky[1] && sky[1] > sky[0] && sky[2] > 40,
+            "zenith pixel {x} is {sky:?}, not blue sky"
+        );
+        assert_eq!(off.get_pixel(x, 0).0, [0, 0, 0, 255]);
+    }
+    assert!(
+        row(&on, h / 5) > row(&on, 0),
+        "the sky does not brighten towards the horizon"
+    );
+    // Per column, the first terrain row under the horizon (the first non-black pixel without air) and the bottom
+    // row: how far the atmosphere moves each from its colour without air.
+    let change = |x: u32, y: u32| {
+        let (a, b) = (on.get_pixel(x, y).0, off.get_pixel(x, y).0);
+        (0..3)
+            .map(|c| (a[c] as f64 - b[c] as f64).abs())
+            .sum::<f64>()
+    };
+    let (mut far, mut near, mut columns) = (0.0, 0.0, 0.0);
+    for x in 0..w {
+        if let Some(horizon) = (0..h).find(|&y| off.get_pixel(x, y).0 != [0, 0, 0, 255]) {
+            far += change(x, (horizon + 1).min(h - 1));
+            near += change(x, h - 1);
+            columns += 1.0;
+        }
+    }
+    assert!(columns > 0.0, "no terrain in view");
+    let (far, near) = (far / columns, near / columns);
+    assert!(
+        far > 3.0 * near && far > 30.0,
+        "aerial perspective: the air changes the horizon by {far:.1} and the near ground by {near:.1}"
+    );
+    common::assert_no_validation_errors(ctx);
+}
+
+/// From orbit the limb glows (pixels whose ray passes through the shell and meets no terrain show the air), and
+/// space beyond the shell keeps the clear colour.
+#[test]
+fn the_limb_glows_from_orbit_and_space_stays_dark() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = world();
+    let size = [320, 240];
+    let r = world.planet.radius;
+    let camera = Camera::look_at(
+        DVec3::new(0.3, 0.5, 0.8).normalize() * r * 3.0,
+        DVec3::ZERO,
+        45.0,
+        4.0 / 3.0,
+        10.0,
+    );
+    let on = render_air(ctx, &camera, size, true);
+    let off = render_air(ctx, &camera, size, false);
+    on.save(out_dir().join("air-orbit-on.png")).unwrap();
+    let top = r + world.planet.sea_level as f64 + world.config.planet.atmosphere_height as f64;
+    let bottom = r + world.planet.sea_level as f64;
+    let inverse = camera.clip().inverse();
+    let (mut limb, mut limb_off, mut limb_pixels) = (0.0, 0.0, 0);
+    for (x, y, pixel) in on.enumerate_pixels() {
+        let ndc = |v: u32, n: u32| (v as f64 + 0.5) / n as f64 * 2.0 - 1.0;
+        let p = inverse * glam::DVec4::new(ndc(x, size[0]), ndc(y, size[1]), 1.0, 1.0);
+        let near = p.truncate() / p.w;
+        let dir = (near - camera.position).normalize();
+        // Closest approach of the view ray to the planet's centre.
+        let closest = camera.position.cross(dir).length();
+        let uncovered = off.get_pixel(x, y).0 == [0, 0, 0, 255];
+        if uncovered && closest > bottom + 0.5 && closest < top - 2.0 {
+            limb += brightness(pixel);
+            limb_off += brightness(off.get_pixel(x, y));
+            limb_pixels += 1;
+        } else if closest > top + 1.0 {
+            assert_eq!(
+                pixel.0,
+                [0, 0, 0, 255],
+                "pixel ({x}, {y}) in space shows {:?}",
+                pixel.0
+            );
+        }
+    }
+    assert!(limb_pixels > 100, "only {limb_pixels} limb pixels");
+    let (limb, limb_off) = (limb / limb_pixels as f64, limb_off / limb_pixels as f64);
+    assert!(
+        limb > 25.0 && limb_off == 0.0,
+        "limb brightness {limb:.1} with air, {limb_off:.1} without"
+    );
+    common::assert_no_validation_errors(ctx);
+}
+
+/// Beyond the thesis: the water flows. Half a second later the rivers' ripples and foam have moved and nothing
+/// else has; still water (the thesis's) does not change with time.
+#[test]
+fn the_water_moves_with_time_and_the_land_does_not() {
+    let Some(ctx) = common::gpu() else { return };
+    let size = [256, 144];
+    let camera = preset_camera(Preset::River, size[0] as f64 / size[1] as f64);
+    let at = |time: f32, flowing: bool| {
+        render_with(ctx, &camera, size, |r| {
+            r.water_mode = WaterMode::Geometry;
+            r.time = time;
+            r.flowing_water = flowing;
+        })
+    };
+    let (before, after) = (at(0.0, true), at(0.5, true));
+    let still = at(0.0, false);
+    assert_eq!(still, at(0.5, false), "still water changed with time");
+    let mut moved = 0;
+    for (x, y, p) in before.enumerate_pixels() {
+        if p != after.get_pixel(x, y) {
+            moved += 1;
+            let s = still.get_pixel(x, y).0;
+            // Land is green (green well above blue); water and its banks' foam are not.
+            assert!(
+                s[2] as i32 + 12 >= s[1] as i32,
+                "pixel ({x}, {y}) changed with time but is land ({s:?})"
+            );
+        }
+    }
+    assert!(moved > 100, "only {moved} pixels of water moved");
+    common::assert_no_validation_errors(ctx);
 }

@@ -30,6 +30,10 @@ struct Findings {
     worst_excess: f64,
     /// The largest rise of the water from one checked point to the next downstream one along a segment.
     worst_rise: f64,
+    /// River centres whose flow (the kernel's weighted sample direction) does not point downstream, the way the
+    /// water falls (within 60 degrees of the segment's direction of increasing t), of `centres`.
+    upstream_flows: usize,
+    centres: usize,
     checked: usize,
 }
 
@@ -41,6 +45,8 @@ fn survey(world: &World) -> Findings {
     let mut findings = Findings {
         worst_excess: f64::MIN,
         worst_rise: f64::MIN,
+        upstream_flows: 0,
+        centres: 0,
         checked: 0,
     };
     for system in &world.network.systems {
@@ -71,7 +77,8 @@ fn survey(world: &World) -> Findings {
                 }
                 let kernel =
                     |q: DVec2| calculate_height([q.x as f32, q.y as f32], &samples, &params);
-                let water = kernel(centre).water_height as f64;
+                let texel = kernel(centre);
+                let water = texel.water_height as f64;
                 if water <= sea + 1e-6 {
                     continue;
                 }
@@ -88,6 +95,10 @@ fn survey(world: &World) -> Findings {
                         + (h(0, 1) * (1.0 - fx) + h(1, 1) * fx) * fy
                 };
                 let d = DVec2::from(sample.derivative.map(|x| x as f64)).normalize();
+                findings.centres += 1;
+                if DVec2::from(texel.flow.map(|x| x as f64)).dot(d) < 0.5 {
+                    findings.upstream_flows += 1;
+                }
                 let across = d.perp();
                 let half = sample.width as f64 * 0.5;
                 let reach = params.influence_distance as f64;
@@ -128,14 +139,22 @@ fn world(model: RiverModel) -> World {
 }
 
 #[test]
-fn drained_rivers_run_below_their_banks_and_never_rise_at_level_6() {
+fn drained_rivers_run_below_their_banks_never_rise_and_flow_downstream_at_level_6() {
     let world = world(RiverModel::Drainage);
     let f = survey(&world);
     println!(
-        "{} points beside rivers: water at most {:.4} above the drawn terrain, rising at most {:.4}",
-        f.checked, f.worst_excess, f.worst_rise
+        "{} points beside rivers: water at most {:.4} above the drawn terrain, rising at most {:.4}; {} of {} \
+         centres flow otherwise than downstream",
+        f.checked, f.worst_excess, f.worst_rise, f.upstream_flows, f.centres
     );
     assert!(f.checked > 10_000);
+    // Where rivers meet or run side by side the flow mixes them: 88 of 14,322 centres (0.6 %) measured.
+    assert!(
+        f.upstream_flows * 100 <= f.centres,
+        "{} of {} river centres flow otherwise than downstream",
+        f.upstream_flows,
+        f.centres
+    );
     assert!(
         f.worst_excess <= BANK_TOLERANCE,
         "water {} above its banks",

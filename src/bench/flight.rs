@@ -110,6 +110,7 @@ pub struct FlightReport {
     pub morphing: bool,
     pub parent_reuse: bool,
     pub frames_in_flight: usize,
+    pub atmosphere: bool,
     pub lod_rule: crate::config::LodRule,
     pub river_model: crate::config::RiverModel,
     pub radius: f64,
@@ -149,6 +150,8 @@ pub struct FlightOptions {
     pub frames_in_flight: usize,
     /// The level-of-detail rule instead of the configuration's.
     pub lod_rule: Option<crate::config::LodRule>,
+    /// The atmosphere (`false`: the constant haze).
+    pub atmosphere: bool,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -182,6 +185,7 @@ fn fly(
     renderer.water_mode = water;
     renderer.morphing = options.morphing;
     renderer.parent_reuse = options.parent_reuse;
+    renderer.atmosphere_on = options.atmosphere;
     renderer.set_frames_in_flight(options.frames_in_flight)?;
     if let Some(rule) = options.lod_rule {
         renderer.lod_rule = rule;
@@ -206,6 +210,8 @@ fn fly(
     let result = (|| {
         for frame in 0..options.frames {
             let camera = flight.camera(world, frame);
+            // The water flows as it would at 30 frames a second.
+            renderer.time = frame as f32 / 30.0;
             let start = std::time::Instant::now();
             let mut stats = renderer.render(
                 &camera,
@@ -467,6 +473,7 @@ pub fn flight_bench(
         stress: options.stress,
         descent: options.descent,
         morphing: options.morphing,
+        atmosphere: options.atmosphere,
         parent_reuse: options.parent_reuse,
         frames_in_flight: options.frames_in_flight,
         lod_rule: options

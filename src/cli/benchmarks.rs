@@ -92,6 +92,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             lod_rule,
             frames_in_flight,
             frames,
+            atmosphere,
             speed,
             size,
             no_kernel_comparison,
@@ -130,6 +131,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 parent_reuse: !no_parent_reuse,
                 lod_rule,
                 frames_in_flight,
+                atmosphere: atmosphere.on(),
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {

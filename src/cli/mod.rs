@@ -138,6 +138,21 @@ pub struct RenderArgs {
     /// `distance` (the thesis's Eq. 6.1).
     #[arg(long, value_parser = parse_lod_rule)]
     pub lod_rule: Option<LodRule>,
+    /// The atmosphere (single scattering in the shell of atmosphere-height; beyond the thesis). `off`: a
+    /// constant haze and the clear colour behind the planet, for comparisons.
+    #[arg(long, value_enum, default_value = "on")]
+    pub atmosphere: Switch,
+    /// Water that flows (beyond the thesis): ripples carried downstream, foam at banks and shores. `off`: the
+    /// thesis's still water.
+    #[arg(long, value_enum, default_value = "on")]
+    pub flowing_water: Switch,
+    /// Put the sun this many degrees above the camera's horizon, straight ahead (-90 to 90; 3 is a sunset)
+    /// [default: over the camera's shoulder].
+    #[arg(long, value_parser = parse_elevation, allow_hyphen_values = true)]
+    pub sun_elevation: Option<f64>,
+    /// Seconds of animation: how far the water has flowed (a sequence of frames differs in this).
+    #[arg(long, default_value_t = 0.0, value_parser = non_negative_number)]
+    pub time: f64,
     #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
     pub clear_color: glam::DVec3,
     /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
@@ -160,11 +175,32 @@ pub struct ViewArgs {
     pub look_at: glam::DVec3,
     #[arg(long, value_enum, default_value = "auto")]
     pub water: WaterMode,
+    /// The atmosphere (single scattering in the shell of atmosphere-height; beyond the thesis). `off`: a
+    /// constant haze and the clear colour behind the planet, for comparisons.
+    #[arg(long, value_enum, default_value = "on")]
+    pub atmosphere: Switch,
+    /// Water that flows (beyond the thesis): ripples carried downstream, foam at banks and shores. `off`: the
+    /// thesis's still water.
+    #[arg(long, value_enum, default_value = "on")]
+    pub flowing_water: Switch,
     /// Run this many frames, then exit (with --screenshot, write it first).
     #[arg(long)]
     pub frames: Option<u64>,
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+}
+
+/// A feature that is on unless switched off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Switch {
+    On,
+    Off,
+}
+
+impl Switch {
+    pub fn on(self) -> bool {
+        self == Switch::On
+    }
 }
 
 /// The planet a command makes.
@@ -256,6 +292,9 @@ pub enum BenchCommand {
         frames_in_flight: usize,
         #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..))]
         frames: u32,
+        /// The atmosphere (beyond the thesis); `off`: a constant haze, as before it.
+        #[arg(long, value_enum, default_value = "on")]
+        atmosphere: Switch,
         /// Camera speed factor (the stress test uses 25).
         #[arg(long, default_value_t = 1.0, value_parser = positive_number, allow_hyphen_values = true)]
         speed: f64,
@@ -305,6 +344,22 @@ fn parse_lod_rule(text: &str) -> Result<LodRule, String> {
         _ => Err(format!(
             "'{text}' is not a level-of-detail rule: screen-space-error or distance (the thesis's Eq. 6.1)"
         )),
+    }
+}
+
+/// An angle above the horizon in degrees, -90 to 90.
+fn parse_elevation(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if (-90.0..=90.0).contains(&x) => Ok(x),
+        _ => Err(format!("'{text}' is not an angle from -90 to 90 degrees")),
+    }
+}
+
+/// A finite number of at least 0.
+fn non_negative_number(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("'{text}' is not a finite number of at least 0")),
     }
 }
 

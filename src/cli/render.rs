@@ -44,6 +44,19 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     renderer.view_mode = args.view;
     renderer.variant = args.kernel;
     renderer.morphing = !args.no_morphing;
+    renderer.atmosphere_on = args.atmosphere.on();
+    renderer.flowing_water = args.flowing_water.on();
+    renderer.time = args.time as f32;
+    if let Some(elevation) = args.sun_elevation {
+        // Straight ahead along the camera's horizon, raised by the elevation.
+        let up = eye.normalize();
+        let forward = look_at - eye;
+        let ahead = (forward - up * forward.dot(up))
+            .try_normalize()
+            .unwrap_or_else(|| up.any_orthonormal_vector());
+        let e = elevation.to_radians();
+        renderer.sun = Some(ahead * e.cos() + up * e.sin());
+    }
     if let Some(rule) = args.lod_rule {
         renderer.lod_rule = rule;
     }
@@ -141,6 +154,8 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
             frames: args.frames,
             screenshot: args.screenshot.clone(),
             water: args.water,
+            atmosphere: args.atmosphere.on(),
+            flowing_water: args.flowing_water.on(),
         },
     )?;
     Ok(())

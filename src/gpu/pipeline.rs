@@ -244,8 +244,20 @@ pub struct GraphicsDesc<'a> {
     pub depth_write: bool,
     /// Depth test: GREATER (reversed Z).
     pub depth_test: bool,
-    pub alpha_blend: bool,
+    pub blend: Blend,
     pub wireframe: bool,
+}
+
+/// How a graphics pipeline's colour output combines with the attachment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// Replace.
+    None,
+    /// `source x alpha + destination x (1 - alpha)`: translucent surfaces.
+    Alpha,
+    /// `source + destination x alpha`: light added in front of what shows through a medium that lets `alpha` of
+    /// it through.
+    Transmit,
 }
 
 /// A graphics pipeline and its layout.
@@ -318,19 +330,25 @@ impl GraphicsPipeline {
                 .depth_test_enable(desc.depth_test)
                 .depth_write_enable(desc.depth_write)
                 .depth_compare_op(vk::CompareOp::GREATER_OR_EQUAL);
-            let blend_attachment = [if desc.alpha_blend {
+            let blend_factors = |src, dst| {
                 vk::PipelineColorBlendAttachmentState::default()
                     .blend_enable(true)
-                    .src_color_blend_factor(vk::BlendFactor::SRC_ALPHA)
-                    .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
+                    .src_color_blend_factor(src)
+                    .dst_color_blend_factor(dst)
                     .color_blend_op(vk::BlendOp::ADD)
                     .src_alpha_blend_factor(vk::BlendFactor::ZERO)
                     .dst_alpha_blend_factor(vk::BlendFactor::ONE)
                     .alpha_blend_op(vk::BlendOp::ADD)
                     .color_write_mask(vk::ColorComponentFlags::RGBA)
-            } else {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            };
+            let blend_attachment = [match desc.blend {
+                Blend::None => vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA),
+                Blend::Alpha => blend_factors(
+                    vk::BlendFactor::SRC_ALPHA,
+                    vk::BlendFactor::ONE_MINUS_SRC_ALPHA,
+                ),
+                Blend::Transmit => blend_factors(vk::BlendFactor::ONE, vk::BlendFactor::SRC_ALPHA),
             }];
             let blend =
                 vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachment);

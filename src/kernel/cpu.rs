@@ -25,6 +25,8 @@ pub struct SampleContribution {
     pub w_river: f32,
     /// Distance to the sample, negated when the vertex lies left of the sample's direction.
     pub dist: f32,
+    /// Beyond the thesis: the sample's unit direction (downstream) times `w_river`, for the water's flow.
+    pub flow: [f32; 2],
 }
 
 fn length(x: f32, y: f32) -> f32 {
@@ -65,6 +67,7 @@ pub fn calculate_height_by_sample(
         in_river_depth: 0.0,
         w_river: 0.0,
         dist,
+        flow: [0.0; 2],
     };
     if projection_distance < half_width && normal_distance <= half_width {
         let normal_factor = normal_distance / half_width;
@@ -72,6 +75,14 @@ pub fn calculate_height_by_sample(
         c.in_river = true;
         c.w_river = 1.0 - projection_distance / half_width;
         c.in_river_depth = c.w_river * factor * c.basin_depth;
+        // 1 / |p'| as the GPU kernel computes it, through 1 / (half width x |p'|); a zero p' gives a zero flow.
+        let speed = if d == [0.0, 0.0] {
+            1.0
+        } else {
+            length(d[0], d[1])
+        };
+        let unit = (1.0 / (half_width * speed)) * half_width;
+        c.flow = [c.w_river * (d[0] * unit), c.w_river * (d[1] * unit)];
     }
     // Side of the line p -> p + p' (2D cross product); left of the flow direction is negative.
     let side = d[0] * (v[1] - p[1]) - d[1] * (v[0] - p[0]);
@@ -92,6 +103,7 @@ pub struct Accumulators {
     pub in_river_sum: f32,
     pub in_river_w_sum: f32,
     pub min_distance: f32,
+    pub flow_sum: [f32; 2],
 }
 
 /// Procedure 4, Section 6.5: accumulate the weighted contributions of every relevant sample.
@@ -109,6 +121,7 @@ pub fn accumulate_height(
         in_river_sum: 0.0,
         in_river_w_sum: 0.0,
         min_distance: f32::MAX,
+        flow_sum: [0.0; 2],
     };
     for sample in samples {
         let Some(c) = calculate_height_by_sample(v, sample, params) else {
@@ -122,6 +135,8 @@ pub fn accumulate_height(
             acc.in_river = true;
             acc.in_river_sum += c.in_river_depth;
             acc.in_river_w_sum += c.w_river;
+            acc.flow_sum[0] += c.flow[0];
+            acc.flow_sum[1] += c.flow[1];
         }
         if c.dist.abs() < acc.min_distance.abs() {
             acc.min_distance = c.dist;
@@ -141,6 +156,7 @@ pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelPar
             water_height: params.sea_level,
             min_distance: params.influence_distance,
             river_width: 0.0,
+            flow: [0.0; 2],
         };
     }
     let height = acc.height_sum / acc.weight_sum;
@@ -176,6 +192,11 @@ pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelPar
         water_height,
         min_distance: acc.min_distance,
         river_width,
+        flow: if acc.in_river {
+            acc.flow_sum.map(|f| f / acc.in_river_w_sum)
+        } else {
+            [0.0; 2]
+        },
     }
 }
 

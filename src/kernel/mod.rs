@@ -57,7 +57,7 @@ impl KernelParams {
     }
 }
 
-/// The five per-vertex outputs of Procedure 5. `river_width` is the weighted *half* width, as the procedure
+/// The five per-vertex outputs of Procedure 5, and the flow. `river_width` is the weighted *half* width, as the procedure
 /// accumulates it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RiverTexel {
@@ -66,6 +66,10 @@ pub struct RiverTexel {
     pub water_height: f32,
     pub min_distance: f32,
     pub river_width: f32,
+    /// Beyond the thesis: the water's flow, the mean of the unit directions (downstream, in the patch frame) of
+    /// the samples whose river covers the vertex, weighted as in the river depth (`w_river`); shorter than 1
+    /// where they disagree, zero outside every river.
+    pub flow: [f32; 2],
 }
 
 /// The work for one patch: the grid spacing and the samples that influence it.
@@ -120,7 +124,7 @@ impl<'a> PatchJob<'a> {
     }
 }
 
-/// The largest difference in any of the five outputs between two sets of patches (GPU vs CPU reference).
+/// The largest difference in any output (the five and the flow) between two sets of patches (GPU vs CPU reference).
 pub fn max_abs_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
     a.iter()
         .flatten()
@@ -132,6 +136,8 @@ pub fn max_abs_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
                 (x.water_height - y.water_height).abs(),
                 (x.min_distance - y.min_distance).abs(),
                 (x.river_width - y.river_width).abs(),
+                (x.flow[0] - y.flow[0]).abs(),
+                (x.flow[1] - y.flow[1]).abs(),
             ]
             .into_iter()
             .fold(0.0f32, f32::max)

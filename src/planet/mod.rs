@@ -2,6 +2,8 @@
 //! the coarse levels are precomputed ([`PRECOMPUTED_LEVEL`]); every finer patch gets its heights on demand from its
 //! parent's (`detail`).
 
+pub mod air;
+pub mod atmosphere;
 pub mod continents;
 pub mod cube;
 pub mod detail;

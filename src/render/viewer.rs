@@ -1,9 +1,9 @@
-//! The native viewer (winit): a fly camera whose speed scales with altitude, keys for the water mode, wireframe,
-//! level-of-detail colours, freezing the level of detail, the kernel variant and screenshots; the seed, frame and
+//! The native viewer (winit): a fly camera whose speed scales with altitude, keys for the water mode, atmosphere,
+//! wireframe, level-of-detail colours, freezing the level of detail, the kernel variant and screenshots; the seed, frame and
 //! per-pass GPU times in the title bar. Survives resize and minimise.
 //!
 //! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look, Shift faster; M water mode,
-//! F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
+//! T atmosphere, F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
 //! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, H back to the start
 //! view, P screenshot, Escape quit.
 
@@ -59,6 +59,8 @@ pub struct ViewerOptions {
     /// Written after the last frame (with `frames`) or on P.
     pub screenshot: Option<PathBuf>,
     pub water: super::WaterMode,
+    pub atmosphere: bool,
+    pub flowing_water: bool,
 }
 
 /// Opens the viewer and runs until the window closes (or `frames` are done).
@@ -294,6 +296,7 @@ impl App<'_> {
         else {
             return Ok(());
         };
+        renderer.time += dt as f32;
         let Some((index, acquired, rendered)) = swapchain.acquire()? else {
             return self.recreate_swapchain();
         };
@@ -332,14 +335,15 @@ impl App<'_> {
         let renderer = self.renderer.as_ref();
         let gpu = |name: &str| stats.gpu_ms.get(name).copied().unwrap_or(0.0);
         window.set_title(&format!(
-            "riverplanet | seed {} | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} ms | {} patches \
-             ({} new) | altitude {:.1} | water {:?}{}{}{}",
+            "riverplanet | seed {} | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} sky {:.1} ms | {} \
+             patches ({} new) | altitude {:.1} | water {:?}{}{}{}",
             self.world.seed,
             self.smoothed_ms,
             1000.0 / self.smoothed_ms.max(1e-3),
             gpu("kernel"),
             gpu("terrain"),
             gpu("water"),
+            gpu("sky"),
             stats.visible_patches,
             stats.new_patches,
             self.altitude(),
@@ -398,6 +402,7 @@ impl App<'_> {
             // Home: back to the start view, wherever the flight went.
             KeyCode::KeyH => self.camera = FlyCamera::new(self.options.eye, self.options.look_at),
             KeyCode::KeyM => renderer.water_mode = renderer.water_mode.next(),
+            KeyCode::KeyT => renderer.atmosphere_on = !renderer.atmosphere_on,
             KeyCode::KeyF => renderer.wireframe_on = !renderer.wireframe_on,
             KeyCode::KeyL => {
                 renderer.view_mode = if renderer.view_mode == ViewMode::Lod {
@@ -486,6 +491,8 @@ impl ApplicationHandler for App<'_> {
         self.window = Some(window);
         if let Some(renderer) = &mut self.renderer {
             renderer.water_mode = self.options.water;
+            renderer.atmosphere_on = self.options.atmosphere;
+            renderer.flowing_water = self.options.flowing_water;
         }
         if let Err(e) = self.recreate_swapchain() {
             self.fail(event_loop, e);

@@ -24,6 +24,7 @@ pub fn decode_texels(bytes: &[u8], grid_size: u32) -> Vec<RiverTexel> {
                 water_height,
                 min_distance,
                 river_width: width[0],
+                flow: [width[1], width[2]],
             },
         )
         .collect()

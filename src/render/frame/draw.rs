@@ -1,6 +1,6 @@
 //! Draw recording (Chapter 8): one instance per visible patch (its own data or the part of an ancestor standing
 //! in), with its morph towards its parent; the terrain drawn per quadrant, then the water through the geometry
-//! shader; optionally every terrain vertex captured as the vertex shader placed it.
+//! shader, then the sky where no surface is; optionally every terrain vertex captured as the vertex shader placed it.
 
 use std::collections::HashMap;
 
@@ -24,6 +24,7 @@ pub(super) struct FramePush {
     sun: [f32; 4],
     planet: [f32; 4],
     extra: [f32; 4],
+    camera: [f32; 4],
 }
 
 /// std430 mirror of `PatchInstance` in glsl/terrain_common.glsl.
@@ -283,6 +284,13 @@ impl Renderer<'_> {
                 + camera.up * 0.3)
                 .normalize()
         });
+        let sky = self.sky();
+        let draw_sky = sky.is_some();
+        let view_mode = match self.view_mode {
+            ViewMode::Shaded => 0,
+            ViewMode::Lod => 1,
+            ViewMode::PaintedRed => 2,
+        };
         let push = FramePush {
             view_projection: to_f32(camera.projection() * camera.rotation()),
             sun: [
@@ -294,18 +302,20 @@ impl Renderer<'_> {
             planet: [
                 radius as f32,
                 n as f32,
-                self.water_mode as u32 as f32,
-                match self.view_mode {
-                    ViewMode::Shaded => 0.0,
-                    ViewMode::Lod => 1.0,
-                    ViewMode::PaintedRed => 2.0,
-                },
+                (self.water_mode as u32 + 4 * view_mode + 16 * !self.flowing_water as u32) as f32,
+                self.heights.min as f32,
             ],
             extra: [
-                0.0,
-                0.0,
+                sky.map_or(-1.0, |s| s.slot()),
+                self.time,
                 self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
                 self.capture_vertices as u32 as f32,
+            ],
+            camera: [
+                camera.position.x as f32,
+                camera.position.y as f32,
+                camera.position.z as f32,
+                sky.map_or(0.0, |s| s.height),
             ],
         };
         rec.raw_image_transition(
@@ -372,6 +382,11 @@ impl Renderer<'_> {
             );
         }
         self.frames.profiler().end(rec, scope);
+        if let (true, Some(sky)) = (draw_sky, &self.sky) {
+            let scope = self.frames.profiler().begin(rec, "sky")?;
+            sky.record(rec, &sets, push);
+            self.frames.profiler().end(rec, scope);
+        }
         rec.end_rendering();
         if color_layouts.1 != vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL {
             rec.raw_image_transition(

@@ -6,6 +6,7 @@
 mod draw;
 mod inflight;
 mod plan;
+mod sky;
 mod upload;
 
 use std::{collections::BTreeMap, time::Instant};
@@ -23,14 +24,14 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         frames::{FrameRing, FRAMES_IN_FLIGHT},
-        pipeline::{BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
+        pipeline::{Blend, BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
         vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
     },
     kernel::{
         gpu::{KernelTuning, KernelVariant, RiverKernel},
         KernelParams, RiverSample,
     },
-    planet::Planet,
+    planet::{atmosphere::Atmosphere, Planet},
     refine::HeightRefiner,
     river::network::RiverNetwork,
     runtime::{
@@ -148,6 +149,8 @@ pub struct Renderer<'w> {
     terrain: GraphicsPipeline,
     water: GraphicsPipeline,
     wireframe: GraphicsPipeline,
+    /// The atmosphere's table and sky pass; `None` for a planet without air (`atmosphere-height` 0).
+    sky: Option<sky::Sky>,
     instance_layout: BufferSetLayout,
     /// Bound in place of a capture buffer when vertices are not captured.
     no_capture: Buffer,
@@ -176,6 +179,14 @@ pub struct Renderer<'w> {
     pub view_mode: ViewMode,
     pub wireframe_on: bool,
     pub freeze_lod: bool,
+    /// Beyond the thesis: the atmosphere (scattering in the shell of `atmosphere-height`); `false`: a constant
+    /// haze and the clear colour behind the planet, as before it.
+    pub atmosphere_on: bool,
+    /// Beyond the thesis: rippled water carried by the rivers' flow, foam at banks and shores; `false`: still,
+    /// flat water as the thesis draws it (Section 8.4).
+    pub flowing_water: bool,
+    /// Seconds of animation: how far the water has flowed.
+    pub time: f32,
     /// Beyond the thesis: patches selected by their nearest point and morphed towards their parent before a
     /// switch (CDLOD); `false`: the thesis's Eq. 6.1 on patch centres and instant switching.
     pub morphing: bool,
@@ -211,7 +222,7 @@ impl<'w> Renderer<'w> {
         let memory = config.rendering.resident_memory_mb as usize * 1024 * 1024;
         let capacity =
             (config.rendering.max_resident_patches as usize).min(memory / max_patch_bytes(n));
-        let bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
+        let mut bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
         // Two slots per patch at most; keep the cache within what the bindless arrays hold.
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
         let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
@@ -241,7 +252,7 @@ impl<'w> Renderer<'w> {
                     depth_format,
                     depth_write: !water,
                     depth_test: true,
-                    alpha_blend: water,
+                    blend: if water { Blend::Alpha } else { Blend::None },
                     wireframe,
                 },
             )
@@ -249,6 +260,22 @@ impl<'w> Renderer<'w> {
         let terrain = pipeline("terrain", false, false)?;
         let water = pipeline("water", true, false)?;
         let wireframe = pipeline("terrain wireframe", false, true)?;
+        let air = Atmosphere::new(
+            planet.radius,
+            planet.sea_level as f64,
+            config.planet.atmosphere_height as f64,
+        );
+        let sky = air
+            .map(|a| {
+                sky::Sky::new(
+                    ctx,
+                    &mut bindless,
+                    &a,
+                    &layouts,
+                    (color_format, depth_format),
+                )
+            })
+            .transpose()?;
         let PatchMesh {
             indices: mesh,
             quadrants,
@@ -282,6 +309,7 @@ impl<'w> Renderer<'w> {
             terrain,
             water,
             wireframe,
+            sky,
             instance_layout,
             no_capture,
             indices,
@@ -308,6 +336,9 @@ impl<'w> Renderer<'w> {
             view_mode: ViewMode::Shaded,
             wireframe_on: false,
             freeze_lod: false,
+            atmosphere_on: true,
+            flowing_water: true,
+            time: 0.0,
             morphing: true,
             parent_reuse: true,
             sun: None,
@@ -474,6 +505,9 @@ impl<'w> Renderer<'w> {
         self.terrain.destroy(ctx);
         self.water.destroy(ctx);
         self.wireframe.destroy(ctx);
+        if let Some(sky) = self.sky {
+            sky.destroy(ctx, &mut self.bindless);
+        }
         self.instance_layout.destroy(ctx);
         ctx.retire_buffer(self.no_capture);
         let _ = ctx.wait_idle();

@@ -1,0 +1,28 @@
+#version 460
+// Beyond the thesis: the sky and the glow of the limb from the dome's per-vertex scattering (sky.vert), with the
+// phase functions per pixel so that the sun's aureole stays round; the sun's disc; added to the clear colour that
+// the air lets through.
+#include "terrain_common.glsl"
+#include "atmosphere.glsl"
+
+// Covered pixels are rejected before shading.
+layout(early_fragment_tests) in;
+
+layout(location = 0) in vec3 vView;
+layout(location = 1) in vec3 vRayleigh;
+layout(location = 2) in vec3 vMie;
+layout(location = 3) in vec3 vTransmittance;
+layout(location = 0) out vec4 outColor;
+
+// The sun's angular radius, widened to a few pixels at typical fields of view.
+const float SUN_COS = 0.99985;
+
+void main() {
+    vec3 dir = normalize(vView);
+    float c = dot(dir, normalize(frame.sun.xyz));
+    vec3 sky = toneMap(inscattered(vRayleigh, vMie, c));
+    float sun = smoothstep(SUN_COS, 1.0 - 0.25 * (1.0 - SUN_COS), c);
+    sky += sun * vTransmittance * (1.0 - sky);
+    // Blend::Transmit: result = sky + clear colour x the air's (grey) transmittance.
+    outColor = vec4(sky, dot(vTransmittance, vec3(1.0 / 3.0)) * (1.0 - sun));
+}

@@ -1,0 +1,174 @@
+//! The atmosphere on the GPU (beyond the thesis; docs/rendering.md, "Atmosphere"): the transmittance table as a
+//! bindless texture that every pass reads, and the sky pass that draws the air where no surface is.
+
+use super::{FramePush, Renderer};
+use crate::{
+    gpu::{
+        bindless::{Bindless, Slot},
+        pipeline::{Blend, GraphicsDesc, GraphicsPipeline},
+        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+    },
+    planet::atmosphere::Atmosphere,
+    shaders,
+};
+
+/// Rings of the sky dome (glsl/sky.vert), from the lowest terrain's sphere to the top of the shell.
+const RINGS: u32 = 48;
+/// Segments of every ring.
+const SEGMENTS: u32 = 96;
+
+pub(super) struct Sky {
+    table: Image,
+    slot: Slot,
+    pipeline: GraphicsPipeline,
+    /// The dome's triangles: vertex `ring * (SEGMENTS + 1) + segment`.
+    dome: Buffer,
+    dome_indices: u32,
+    /// atmosphere-height, as the shaders take it.
+    pub(super) height: f32,
+}
+
+impl Sky {
+    /// Computes and uploads the transmittance table of `atmosphere` and builds the sky pipeline.
+    pub(super) fn new(
+        ctx: &Context,
+        bindless: &mut Bindless,
+        atmosphere: &Atmosphere,
+        set_layouts: &[vk::DescriptorSetLayout],
+        formats: (vk::Format, vk::Format),
+    ) -> Result<Self, GpuError> {
+        let table = atmosphere.transmittance_table();
+        let image = ctx.create_image(&ImageDesc {
+            name: "atmosphere transmittance",
+            extent: vk::Extent2D {
+                width: table.width,
+                height: table.height,
+            },
+            layers: 1,
+            format: vk::Format::R32G32B32A32_SFLOAT,
+            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+            aspect: vk::ImageAspectFlags::COLOR,
+            array: true,
+        })?;
+        ctx.run_and_wait("upload atmosphere transmittance", |rec| {
+            rec.image_transitions(
+                &[&image],
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::GENERAL,
+                vk::PipelineStageFlags2::NONE,
+                vk::AccessFlags2::NONE,
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            );
+            rec.upload_image_layer(
+                &image,
+                vk::ImageLayout::GENERAL,
+                0,
+                bytemuck::cast_slice(&table.texels),
+            )?;
+            rec.image_transitions(
+                &[&image],
+                vk::ImageLayout::GENERAL,
+                vk::ImageLayout::GENERAL,
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_WRITE,
+                vk::PipelineStageFlags2::VERTEX_SHADER
+                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
+                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_SAMPLED_READ,
+            );
+            Ok(())
+        })?;
+        let indices = dome_indices();
+        let dome = ctx.create_buffer(&BufferDesc {
+            name: "sky dome indices",
+            size: (indices.len() * 4) as u64,
+            usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })?;
+        ctx.run_and_wait("upload sky dome", |rec| {
+            rec.upload_buffer(&dome, 0, bytemuck::cast_slice(&indices))
+        })?;
+        let slot = bindless.allocate(ctx).ok_or_else(|| {
+            GpuError::Invalid("no bindless slot left for the atmosphere".to_string())
+        })?;
+        bindless.write(ctx, slot, &image, false, vk::ImageLayout::GENERAL);
+        // The dome lies at depth 0: only pixels no surface covered pass the depth test.
+        let pipeline = GraphicsPipeline::new(
+            ctx,
+            &GraphicsDesc {
+                name: "sky",
+                vertex: shaders::SKY_VERT,
+                geometry: None,
+                fragment: shaders::SKY_FRAG,
+                set_layouts,
+                push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+                specialization: &[RINGS, SEGMENTS],
+                color_format: formats.0,
+                depth_format: formats.1,
+                depth_write: false,
+                depth_test: true,
+                blend: Blend::Transmit,
+                wireframe: false,
+            },
+        )?;
+        Ok(Self {
+            table: image,
+            slot,
+            pipeline,
+            dome,
+            dome_indices: indices.len() as u32,
+            height: (atmosphere.top - atmosphere.bottom) as f32,
+        })
+    }
+
+    /// The table's slot, as the shaders take it.
+    pub(super) fn slot(&self) -> f32 {
+        self.slot.0 as f32
+    }
+
+    /// Draws the sky (inside the frame's rendering scope).
+    pub(super) fn record(&self, rec: &mut Recorder, sets: &[vk::DescriptorSet], push: &[u8]) {
+        rec.draw_indexed(
+            &self.pipeline,
+            sets,
+            push,
+            &self.dome,
+            0..self.dome_indices,
+            0..1,
+        );
+    }
+
+    pub(super) fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
+        self.pipeline.destroy(ctx);
+        ctx.retire_buffer(self.dome);
+        ctx.retire_image(self.table);
+        bindless.release(ctx, self.slot);
+    }
+}
+
+impl Renderer<'_> {
+    /// The atmosphere this frame draws: the planet's, unless it has none or `atmosphere_on` is off.
+    pub(super) fn sky(&self) -> Option<&Sky> {
+        self.sky.as_ref().filter(|_| self.atmosphere_on)
+    }
+}
+
+/// Two triangles per ring band and segment.
+fn dome_indices() -> Vec<u32> {
+    let vertex = |ring: u32, segment: u32| ring * (SEGMENTS + 1) + segment;
+    (0..RINGS)
+        .flat_map(|ring| {
+            (0..SEGMENTS).flat_map(move |s| {
+                [
+                    vertex(ring, s),
+                    vertex(ring + 1, s),
+                    vertex(ring, s + 1),
+                    vertex(ring, s + 1),
+                    vertex(ring + 1, s),
+                    vertex(ring + 1, s + 1),
+                ]
+            })
+        })
+        .collect()
+}
