@@ -327,22 +327,28 @@ fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), Plo
     let _ = writeln!(
         w,
         "## The frame on the default planet\n\nBeyond the thesis: the scripted approach on config/planet.xml at the \
-         resolution given, in the default water mode, with each level-of-detail rule (screen-space error, the \
-         default; `distance`, the thesis's Eq. 6.1) and number of frames in flight. Frame times are wall-clock \
-         per frame, waits for the GPU included.\n\n\
-         | report | level of detail | frames in flight | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) |\n\
-         |---|---|---|---|---|---|---|---|"
+         resolution given, in the default water mode, with each level-of-detail rule (`distance`, the thesis's \
+         Eq. 6.1, the default; `screen-space-error`), number of frames in flight, and the atmosphere on (the \
+         default) or off. Frame times are wall-clock per frame, waits for the GPU included.\n\n\
+         | report | level of detail | frames in flight | atmosphere | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) |\n\
+         |---|---|---|---|---|---|---|---|---|"
     );
     for path in paths {
         let d = read_report(path, "bench flight", "summary")?;
         let s = &d["summary"];
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} |",
+            "| {} | {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} |",
             path.file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
             d["lod_rule"].as_str().unwrap_or("?"),
             d["frames_in_flight"],
+            // Reports from before the atmosphere had none.
+            if d["atmosphere"].as_bool().unwrap_or(false) {
+                "on"
+            } else {
+                "off"
+            },
             s["frames"],
             d["resolution"][0],
             d["resolution"][1],
