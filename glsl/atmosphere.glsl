@@ -71,8 +71,8 @@ struct Scattering {
 
 // The segment from `origin` (from the planet's centre) along the unit `dir` up to `tMax`, clipped to the shell,
 // by the midpoint rule with `steps` steps. With `sunAtEnds`, the sunlight is read from the table at the segment's
-// two ends only and interpolated geometrically between them: right for segments whose altitude changes one way
-// (from the eye to the ground), two table reads instead of one per step.
+// two ends only and interpolated linearly between them: close for segments whose altitude changes one way (from
+// the eye to the ground), two table reads instead of one per step and no transcendental more.
 Scattering scatter(Air a, vec3 origin, vec3 dir, float tMax, int steps, bool sunAtEnds) {
     Scattering s;
     s.rayleigh = vec3(0.0);
@@ -104,8 +104,7 @@ Scattering scatter(Air a, vec3 origin, vec3 dir, float tMax, int steps, bool sun
         float mieDensity = exp(-h / a.mieHeight);
         vec3 extinction = a.rayleigh * rayleighDensity + a.mieExtinction * mieDensity;
         float f = (float(k) + 0.5) / float(steps);
-        vec3 sunlight = sunAtEnds ? pow(max(sunFirst, 1e-6), vec3(1.0 - f)) * pow(max(sunLast, 1e-6), vec3(f))
-                                  : sunTransmittance(a, r, dot(p, sun) / r);
+        vec3 sunlight = sunAtEnds ? mix(sunFirst, sunLast, f) : sunTransmittance(a, r, dot(p, sun) / r);
         vec3 light = exp(-(depth + 0.5 * dt * extinction)) * sunlight * dt;
         depth += extinction * dt;
         s.rayleigh += light * rayleighDensity;

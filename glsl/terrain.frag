@@ -19,6 +19,7 @@ layout(location = 11) in vec3 fInscatterMie;
 layout(location = 12) in vec3 fTransmittance;
 layout(location = 13) in vec3 fSunlight;
 layout(location = 14) in vec3 fFlow;
+layout(location = 15) in vec3 fDetail;
 
 layout(location = 0) out vec4 outColor;
 
@@ -45,6 +46,39 @@ const vec3 SNOW = vec3(0.93, 0.94, 0.97);
 const vec3 WATER_SHALLOW = vec3(0.12, 0.42, 0.55);
 const vec3 WATER_DEEP = vec3(0.02, 0.10, 0.28);
 
+// Value noise whose lattice repeats every `period` cells.
+float periodicNoise(vec3 x, float period) {
+    vec3 i = floor(x);
+    vec3 f = fract(x);
+    f = f * f * (3.0 - 2.0 * f);
+    float c[8];
+    for (int k = 0; k < 8; ++k) {
+        c[k] = hash(mod(i + vec3(k & 1, (k >> 1) & 1, k >> 2), period));
+    }
+    return mix(mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y), mix(mix(c[4], c[5], f.x), mix(c[6], c[7], f.x), f.y),
+               f.z);
+}
+
+// Beyond the thesis (terrain close up): detail below the vertex spacing, three octaves of value noise from one
+// world unit down to 1/16, each fading out where its cells shrink below about a pixel, so the ground keeps detail at a few
+// units (metres on config/earth.xml) and a distant fragment computes none. In [0, 1], 0.5 where nothing shows.
+// Coordinates: fDetail, the world position modulo DETAIL_PERIOD (precise near the camera at any planet size).
+float groundDetail() {
+    float footprint = length(fwidth(fDetail));
+    float sum = 0.0;
+    float amplitude = 1.0;
+    float size = 1.0;
+    for (int k = 0; k < 3; ++k) {
+        float fade = 1.0 - smoothstep(0.5, 1.5, footprint / size);
+        if (fade <= 0.0) break;
+        sum += amplitude * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
+        amplitude *= 0.6;
+        size *= 0.25;
+    }
+    // The three amplitudes add up to 1.96.
+    return 0.5 + sum / 1.4;
+}
+
 // Fig. 8.2: weights of the textures by height, with linear transitions; heights in units of frame.extra.z, so
 // that the bands keep their place relative to the mountains on any planet.
 vec3 terrainColour(float height, float slope, vec3 detail) {
@@ -57,7 +91,7 @@ vec3 terrainColour(float height, float slope, vec3 detail) {
     // Steep slopes show rock (8.3).
     c = mix(c, ROCK * 0.9, smoothstep(0.55, 0.8, slope));
     if (h < 0.0) c = mix(SAND, DIRT * 0.6, clamp(-h / 3.0, 0.0, 1.0));
-    return c * (0.85 + 0.3 * detail);
+    return c * (0.7 + 0.6 * detail);
 }
 
 vec3 levelColour(float level) {
@@ -163,9 +197,10 @@ void main() {
     float edge = fwidth(fRiver.z) + 1e-4;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
-    // One octave of detail noise about a world unit across (two octaves cost lavapipe 15 ms a frame at 720p).
-    float detail = noise(fDirection * frame.planet.x);
-    vec3 albedo = terrainColour(fRiver.x, slope * 3.0, vec3(detail));
+    // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).
+    float detail = groundDetail();
+    vec3 albedo = terrainColour(fRiver.x + (detail - 0.5) * 2.0 * frame.extra.z, slope * 3.0 + (detail - 0.5) * 0.3,
+                                vec3(detail));
     if (viewMode() == 1) albedo = mix(albedo, levelColour(fLevel), 0.6);
     vec3 diffuse = max(dot(normal, sun), 0.0) * fSunlight;
     float ambient = 0.18 + 0.12 * max(dot(up, sun) + 0.3, 0.0);

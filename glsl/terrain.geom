@@ -20,6 +20,7 @@ layout(location = 11) in vec3 vInscatterMie[];
 layout(location = 12) in vec3 vTransmittance[];
 layout(location = 13) in vec3 vSunlight[];
 layout(location = 14) in vec3 vFlow[];
+layout(location = 15) in vec3 vDetail[];
 
 layout(location = 0) out vec3 fPosition;
 layout(location = 1) out vec3 fNormal;
@@ -33,6 +34,7 @@ layout(location = 11) out vec3 fInscatterMie;
 layout(location = 12) out vec3 fTransmittance;
 layout(location = 13) out vec3 fSunlight;
 layout(location = 14) out vec3 fFlow;
+layout(location = 15) out vec3 fDetail;
 
 void main() {
     if (vSkirt[0] >= 0 || vSkirt[1] >= 0 || vSkirt[2] >= 0) return;
@@ -74,6 +76,7 @@ void main() {
         fTransmittance = vTransmittance[k];
         fSunlight = vSunlight[k];
         fFlow = vFlow[k];
+        fDetail = vDetail[k];
         gl_Position = frame.viewProjection * vec4(position, 1.0);
         EmitVertex();
     }

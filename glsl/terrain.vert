@@ -25,6 +25,7 @@ layout(location = 11) out vec3 vInscatterMie;
 layout(location = 12) out vec3 vTransmittance;
 layout(location = 13) out vec3 vSunlight;   // the sunlight that reaches the vertex
 layout(location = 14) out vec3 vFlow;       // the river's flow: a tangent, unit length where the samples agree
+layout(location = 15) out vec3 vDetail;     // world position modulo DETAIL_PERIOD, precise near the camera
 
 // Texture coordinates of a grid position in the base-height texture, which has a border of HEIGHT_BORDER points
 // (planet::detail::BORDER) on each side.
@@ -156,6 +157,8 @@ void main() {
     }
 
     vPosition = position;
+    // The patch centre's world position (mod the period, from f64) plus the vertex's small offset from it.
+    vDetail = p.detail.xyz + p.centreDir.xyz * height + offset * (frame.planet.x + height);
     vNormal = normal;
     vDirection = direction;
     vRiver = vec4(height, surface.y, surface.z, surface.w);

@@ -40,7 +40,11 @@ struct PatchInstance {
     ivec4 slots;      // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: parent's river slot or -1
     vec4 morph;       // x: distance where morphing towards the parent starts; y: 1 / morph band length;
                       // zw: the patch's vertex (0, 0) in its parent's river texture
+    vec4 detail;      // xyz: the patch centre's world position modulo DETAIL_PERIOD (computed in f64)
 };
+
+// The period of the ground detail's coordinates (render/frame/draw.rs, DETAIL_PERIOD).
+const float DETAIL_PERIOD = 256.0;
 
 layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance instances[]; };
 // Where the terrain pass puts every vertex when frame.extra.w is 1 (tests): per instance and mesh vertex, the

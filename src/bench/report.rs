@@ -182,13 +182,18 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
         let _ = writeln!(w, "## Flight: {title}\n");
         let _ = writeln!(
             w,
-            "{} frames at {}x{}, switch factor {}. Per frame: {:.1} ms on average ({:.1} fps), median {:.1}, max \
+            "{} frames at {}x{}, switch factor {}, atmosphere {}. Per frame: {:.1} ms on average ({:.1} fps), median {:.1}, max \
              {:.1}; {:.1} visible patches (max {}), {:.2} new (max {}), {:.0} samples (max {}). GPU per pass (ms): \
              {}. CPU per stage (ms): {}.\n",
             s["frames"],
             res[0],
             res[1],
             r["switch_factor"],
+            if r["atmosphere"].as_bool().unwrap_or(false) {
+                "on"
+            } else {
+                "off (the thesis draws none)"
+            },
             f(&s["frame_ms_mean"]),
             f(&s["average_fps"]),
             f(&s["frame_ms_median"]),

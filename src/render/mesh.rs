@@ -7,8 +7,12 @@
 //! the instances that draw that quadrant) without a geometry shader. A midline skirt segment belongs to both
 //! quadrants beside it: it closes the crack towards finer patches on the other side, and hides under the surface
 //! when both sides are drawn.
+//!
+//! Also the sky dome's grid (beyond the thesis, glsl/sky.vert), and the upload of an index buffer.
 
 use std::ops::Range;
+
+use crate::gpu::{vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation};
 
 /// The index buffer and the range of each quadrant in it (bit 0: +i half, bit 1: +j half). The whole buffer is
 /// every triangle at least once (midline skirts twice).
@@ -111,4 +115,37 @@ mod tests {
             }
         }
     }
+}
+
+/// The sky dome's triangles: `rings` bands of `segments` quads, vertex `ring * (segments + 1) + segment`.
+pub fn dome_mesh(rings: u32, segments: u32) -> Vec<u32> {
+    let vertex = |ring: u32, segment: u32| ring * (segments + 1) + segment;
+    (0..rings)
+        .flat_map(|ring| {
+            (0..segments).flat_map(move |s| {
+                [
+                    vertex(ring, s),
+                    vertex(ring + 1, s),
+                    vertex(ring, s + 1),
+                    vertex(ring, s + 1),
+                    vertex(ring + 1, s),
+                    vertex(ring + 1, s + 1),
+                ]
+            })
+        })
+        .collect()
+}
+
+/// `indices` in a device-local index buffer.
+pub fn index_buffer(ctx: &Context, name: &str, indices: &[u32]) -> Result<Buffer, GpuError> {
+    let buffer = ctx.create_buffer(&BufferDesc {
+        name,
+        size: std::mem::size_of_val(indices) as u64,
+        usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        location: MemoryLocation::GpuOnly,
+    })?;
+    ctx.run_and_wait(name, |rec| {
+        rec.upload_buffer(&buffer, 0, bytemuck::cast_slice(indices))
+    })?;
+    Ok(buffer)
 }

@@ -39,6 +39,7 @@ pub struct PatchInstance {
     tex_rect: [f32; 4],
     slots: [i32; 4],
     morph: [f32; 4],
+    detail: [f32; 4],
 }
 
 /// Every drawn terrain vertex of one frame, as the vertex shader placed it.
@@ -458,8 +459,21 @@ fn instance(
             -1,
         ],
         morph: NO_MORPH,
+        detail: [
+            (centre.x * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            (centre.y * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            (centre.z * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            0.0,
+        ],
     }
 }
+
+/// The period in world units of the fragment shader's ground detail: patch centres are reduced modulo it in f64, so
+/// the detail's coordinates stay small (precise to 0.02 mm) at any planet size, and the finest octave's lattice
+/// (4096 cells) stays within what the shader's cheap float hash resolves; every octave's lattice divides it, so
+/// neighbouring patches agree although their centres wrap differently. The detail repeats every 256 units (metres
+/// on config/earth.xml), under terrain that does not.
+const DETAIL_PERIOD: f64 = 256.0;
 
 /// Skirt length beside patches with their own data, in vertex spacings (docs/rendering.md, "No holes").
 const SKIRT_SPACINGS: f32 = 2.0;

@@ -18,7 +18,7 @@ use self::draw::FramePush;
 pub use self::draw::{DrawnVertex, PatchInstance, VertexCapture};
 pub use self::inflight::GpuTimes;
 use self::inflight::{InFlight, TIMESTAMP_SCOPES};
-use super::mesh::{patch_mesh, PatchMesh};
+use super::mesh::{index_buffer, patch_mesh, PatchMesh};
 use crate::{
     config::{Config, LodRule},
     gpu::{
@@ -280,15 +280,7 @@ impl<'w> Renderer<'w> {
             indices: mesh,
             quadrants,
         } = patch_mesh(n);
-        let indices = ctx.create_buffer(&BufferDesc {
-            name: "patch mesh indices",
-            size: (mesh.len() * 4) as u64,
-            usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuOnly,
-        })?;
-        ctx.run_and_wait("upload patch mesh", |rec| {
-            rec.upload_buffer(&indices, 0, bytemuck::cast_slice(&mesh))
-        })?;
+        let indices = index_buffer(ctx, "patch mesh indices", &mesh)?;
         let frames = FrameRing::new(ctx, FRAMES_IN_FLIGHT, TIMESTAMP_SCOPES, "frame")?;
         // Culling bounds: every height any level can reach (finer levels add at most a bound to the precomputed
         // range), with a river basin's depth and a unit of margin either way.

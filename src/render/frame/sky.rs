@@ -6,9 +6,10 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{Blend, GraphicsDesc, GraphicsPipeline},
-        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+        vk, Buffer, Context, GpuError, Image, ImageDesc, Recorder,
     },
     planet::atmosphere::Atmosphere,
+    render::mesh::{dome_mesh, index_buffer},
     shaders,
 };
 
@@ -79,16 +80,8 @@ impl Sky {
             );
             Ok(())
         })?;
-        let indices = dome_indices();
-        let dome = ctx.create_buffer(&BufferDesc {
-            name: "sky dome indices",
-            size: (indices.len() * 4) as u64,
-            usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuOnly,
-        })?;
-        ctx.run_and_wait("upload sky dome", |rec| {
-            rec.upload_buffer(&dome, 0, bytemuck::cast_slice(&indices))
-        })?;
+        let indices = dome_mesh(RINGS, SEGMENTS);
+        let dome = index_buffer(ctx, "sky dome indices", &indices)?;
         let slot = bindless.allocate(ctx).ok_or_else(|| {
             GpuError::Invalid("no bindless slot left for the atmosphere".to_string())
         })?;
@@ -152,23 +145,4 @@ impl Renderer<'_> {
     pub(super) fn sky(&self) -> Option<&Sky> {
         self.sky.as_ref().filter(|_| self.atmosphere_on)
     }
-}
-
-/// Two triangles per ring band and segment.
-fn dome_indices() -> Vec<u32> {
-    let vertex = |ring: u32, segment: u32| ring * (SEGMENTS + 1) + segment;
-    (0..RINGS)
-        .flat_map(|ring| {
-            (0..SEGMENTS).flat_map(move |s| {
-                [
-                    vertex(ring, s),
-                    vertex(ring + 1, s),
-                    vertex(ring, s + 1),
-                    vertex(ring, s + 1),
-                    vertex(ring + 1, s),
-                    vertex(ring + 1, s + 1),
-                ]
-            })
-        })
-        .collect()
 }
