@@ -75,6 +75,39 @@ pub fn patch_mesh(n: u32) -> PatchMesh {
     PatchMesh { indices, quadrants }
 }
 
+/// The sky dome's triangles: `rings` bands of `segments` quads, vertex `ring * (segments + 1) + segment`.
+pub fn dome_mesh(rings: u32, segments: u32) -> Vec<u32> {
+    let vertex = |ring: u32, segment: u32| ring * (segments + 1) + segment;
+    (0..rings)
+        .flat_map(|ring| {
+            (0..segments).flat_map(move |s| {
+                [
+                    vertex(ring, s),
+                    vertex(ring + 1, s),
+                    vertex(ring, s + 1),
+                    vertex(ring, s + 1),
+                    vertex(ring + 1, s),
+                    vertex(ring + 1, s + 1),
+                ]
+            })
+        })
+        .collect()
+}
+
+/// `indices` in a device-local index buffer.
+pub fn index_buffer(ctx: &Context, name: &str, indices: &[u32]) -> Result<Buffer, GpuError> {
+    let buffer = ctx.create_buffer(&BufferDesc {
+        name,
+        size: std::mem::size_of_val(indices) as u64,
+        usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        location: MemoryLocation::GpuOnly,
+    })?;
+    ctx.run_and_wait(name, |rec| {
+        rec.upload_buffer(&buffer, 0, bytemuck::cast_slice(indices))
+    })?;
+    Ok(buffer)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,37 +148,4 @@ mod tests {
             }
         }
     }
-}
-
-/// The sky dome's triangles: `rings` bands of `segments` quads, vertex `ring * (segments + 1) + segment`.
-pub fn dome_mesh(rings: u32, segments: u32) -> Vec<u32> {
-    let vertex = |ring: u32, segment: u32| ring * (segments + 1) + segment;
-    (0..rings)
-        .flat_map(|ring| {
-            (0..segments).flat_map(move |s| {
-                [
-                    vertex(ring, s),
-                    vertex(ring + 1, s),
-                    vertex(ring, s + 1),
-                    vertex(ring, s + 1),
-                    vertex(ring + 1, s),
-                    vertex(ring + 1, s + 1),
-                ]
-            })
-        })
-        .collect()
-}
-
-/// `indices` in a device-local index buffer.
-pub fn index_buffer(ctx: &Context, name: &str, indices: &[u32]) -> Result<Buffer, GpuError> {
-    let buffer = ctx.create_buffer(&BufferDesc {
-        name,
-        size: std::mem::size_of_val(indices) as u64,
-        usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-        location: MemoryLocation::GpuOnly,
-    })?;
-    ctx.run_and_wait(name, |rec| {
-        rec.upload_buffer(&buffer, 0, bytemuck::cast_slice(indices))
-    })?;
-    Ok(buffer)
 }
