@@ -151,7 +151,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_elevation, allow_hyphen_values = true)]
     pub sun_elevation: Option<f64>,
     /// Seconds of animation: how far the water has flowed (a sequence of frames differs in this).
-    #[arg(long, default_value_t = 0.0, value_parser = non_negative_number)]
+    #[arg(long, default_value_t = 0.0, value_parser = non_negative_number, allow_hyphen_values = true)]
     pub time: f64,
     #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
     pub clear_color: glam::DVec3,
