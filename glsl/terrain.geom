@@ -8,19 +8,14 @@
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
 
-layout(location = 0) in vec3 vPosition[];
-layout(location = 1) in vec3 vNormal[];
-layout(location = 2) in vec4 vRiver[];
-layout(location = 5) in vec3 vDirection[];
-layout(location = 6) in vec2 vGrid[];
-layout(location = 7) flat in int vInstance[];
-layout(location = 8) flat in int vSkirt[];
-layout(location = 10) in vec3 vInscatterRayleigh[];
-layout(location = 11) in vec3 vInscatterMie[];
-layout(location = 12) in vec3 vTransmittance[];
-layout(location = 13) in vec3 vSunlight[];
-layout(location = 14) in vec3 vFlow[];
-layout(location = 15) in vec3 vDetail[];
+// water.vert's packed outputs.
+layout(location = 0) in vec4 vLocalInstance[];
+layout(location = 1) in vec4 vRiver[];
+layout(location = 2) in vec4 vDirectionEdge[];
+layout(location = 3) in vec4 vGridFlow[];
+layout(location = 4) in vec4 vRayleighSunR[];
+layout(location = 5) in vec4 vMieSunG[];
+layout(location = 6) in vec4 vTransmittanceSunB[];
 
 layout(location = 0) out vec3 fPosition;
 layout(location = 1) out vec3 fNormal;
@@ -37,10 +32,10 @@ layout(location = 14) out vec3 fFlow;
 layout(location = 15) out vec3 fDetail;
 
 void main() {
-    if (vSkirt[0] >= 0 || vSkirt[1] >= 0 || vSkirt[2] >= 0) return;
-    PatchInstance p = instances[vInstance[0]];
+    if (vDirectionEdge[0].w >= 0.0 || vDirectionEdge[1].w >= 0.0 || vDirectionEdge[2].w >= 0.0) return;
+    PatchInstance p = instances[int(vLocalInstance[0].w)];
     float middle = 0.5 * (frame.planet.y - 1.0);
-    vec2 middleOfTriangle = (vGrid[0] + vGrid[1] + vGrid[2]) / 3.0;
+    vec2 middleOfTriangle = (vGridFlow[0].xy + vGridFlow[1].xy + vGridFlow[2].xy) / 3.0;
     int quadrant = int(middleOfTriangle.x >= middle) | (int(middleOfTriangle.y >= middle) << 1);
     if ((p.slots.z & (1 << quadrant)) == 0) return;
 
@@ -61,22 +56,24 @@ void main() {
     if (!riverWater && !belowSea) return;
     for (int k = 0; k < 3; ++k) {
         float water = riverWater ? vRiver[k].y : seaLevel;
+        vec3 direction = vDirectionEdge[k].xyz;
         // Up from the terrain vertex to the water (a small difference: precise at any planet size).
-        vec3 position = vPosition[k] + vDirection[k] * (water - vRiver[k].x);
+        vec3 local = vLocalInstance[k].xyz + direction * (water - vRiver[k].x);
+        vec3 position = p.centreRel.xyz + local;
         fPosition = position;
-        fNormal = vDirection[k];
+        fNormal = direction;
         fRiver = vec4(vRiver[k].x, water, vRiver[k].z, vRiver[k].w);
         // River water (not sea) is clipped to the basin in the fragment shader.
         fRiverWater = riverWater && !belowSea ? 1 : 0;
         fLevel = p.centreRel.w;
-        fDirection = vDirection[k];
+        fDirection = direction;
         fSpacing = spacing;
-        fInscatterRayleigh = vInscatterRayleigh[k];
-        fInscatterMie = vInscatterMie[k];
-        fTransmittance = vTransmittance[k];
-        fSunlight = vSunlight[k];
-        fFlow = vFlow[k];
-        fDetail = vDetail[k];
+        fInscatterRayleigh = vRayleighSunR[k].xyz;
+        fInscatterMie = vMieSunG[k].xyz;
+        fTransmittance = vTransmittanceSunB[k].xyz;
+        fSunlight = vec3(vRayleighSunR[k].w, vMieSunG[k].w, vTransmittanceSunB[k].w);
+        fFlow = flowTangent(p, vGridFlow[k].zw, direction);
+        fDetail = p.detail.xyz + local;
         gl_Position = frame.viewProjection * vec4(position, 1.0);
         EmitVertex();
     }

@@ -242,7 +242,7 @@ impl<'w> Renderer<'w> {
                 ctx,
                 &GraphicsDesc {
                     name,
-                    vertex: shaders::TERRAIN_VERT,
+                    vertex: if water { shaders::WATER_VERT } else { shaders::TERRAIN_VERT },
                     geometry: water.then_some(shaders::TERRAIN_GEOM),
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
