@@ -46,7 +46,7 @@ vec3 sunTransmittance(Air a, float r, float mu) {
     float xR = rho / horizon;
     vec2 size = vec2(TRANSMITTANCE_WIDTH, TRANSMITTANCE_HEIGHT);
     vec2 uv = 0.5 / size + vec2(xMu, xR) * (1.0 - 1.0 / size);
-    vec3 t = textureLod(patchTextures[nonuniformEXT(int(frame.extra.x))], vec3(uv, 0.0), 0.0).rgb;
+    vec3 t = textureLod(patchTextures[int(frame.extra.x)], vec3(uv, 0.0), 0.0).rgb;
     float s = a.bottom / r;
     float horizonMu = -sqrt(max(1.0 - s * s, 0.0));
     return t * smoothstep(-0.01, 0.01, mu - horizonMu);

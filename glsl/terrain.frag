@@ -7,19 +7,7 @@
 
 layout(constant_id = 0) const uint WATER_PASS = 0;
 
-layout(location = 0) in vec3 fPosition;
-layout(location = 1) in vec3 fNormal;
-layout(location = 2) in vec4 fRiver;
-layout(location = 3) flat in int fRiverWater;
-layout(location = 4) flat in float fLevel;
-layout(location = 5) in vec3 fDirection;
-layout(location = 9) flat in float fSpacing;
-layout(location = 10) in vec3 fInscatterRayleigh;
-layout(location = 11) in vec3 fInscatterMie;
-layout(location = 12) in vec3 fTransmittance;
-layout(location = 13) in vec3 fSunlight;
-layout(location = 14) in vec3 fFlow;
-layout(location = 15) in vec3 fDetail;
+#include "terrain_interface.glsl"
 
 layout(location = 0) out vec4 outColor;
 
@@ -183,7 +171,7 @@ void main() {
     vec3 up = normalize(fDirection);
     vec3 view = normalize(-fPosition);
     if (WATER_PASS == 1) {
-        bool river = fRiverWater == 1;
+        bool river = fRiverWater > 0.5;
         float visible;
         vec3 q = rippleSpace(river, visible);
         // River water covers the basin only: a triangle reaching past the banks is cut at the river's width.

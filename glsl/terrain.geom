@@ -4,6 +4,7 @@
 // width) or below sea level. River water the mesh is too coarse for is left to the fragment shader to paint.
 // (The terrain itself is drawn without a geometry shader, per quadrant: docs/rendering.md says why.)
 #include "terrain_common.glsl"
+#include "atmosphere.glsl"
 
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
@@ -17,19 +18,8 @@ layout(location = 4) in vec4 vRayleighSunR[];
 layout(location = 5) in vec4 vMieSunG[];
 layout(location = 6) in vec4 vTransmittanceSunB[];
 
-layout(location = 0) out vec3 fPosition;
-layout(location = 1) out vec3 fNormal;
-layout(location = 2) out vec4 fRiver;
-layout(location = 3) flat out int fRiverWater;
-layout(location = 4) flat out float fLevel;
-layout(location = 5) out vec3 fDirection;
-layout(location = 9) flat out float fSpacing;
-layout(location = 10) out vec3 fInscatterRayleigh;
-layout(location = 11) out vec3 fInscatterMie;
-layout(location = 12) out vec3 fTransmittance;
-layout(location = 13) out vec3 fSunlight;
-layout(location = 14) out vec3 fFlow;
-layout(location = 15) out vec3 fDetail;
+#define TERRAIN_WRITER
+#include "terrain_interface.glsl"
 
 void main() {
     if (vDirectionEdge[0].w >= 0.0 || vDirectionEdge[1].w >= 0.0 || vDirectionEdge[2].w >= 0.0) return;
@@ -60,20 +50,20 @@ void main() {
         // Up from the terrain vertex to the water (a small difference: precise at any planet size).
         vec3 local = vLocalInstance[k].xyz + direction * (water - vRiver[k].x);
         vec3 position = p.centreRel.xyz + local;
-        fPosition = position;
-        fNormal = direction;
-        fRiver = vec4(vRiver[k].x, water, vRiver[k].z, vRiver[k].w);
+        SurfaceVertex s;
+        s.position = position;
+        s.normal = direction;
+        s.river = vec4(vRiver[k].x, water, vRiver[k].z, vRiver[k].w);
+        s.direction = direction;
+        s.detail = p.detail.xyz + local;
+        s.flow = flowTangent(p, vGridFlow[k].zw, direction);
+        s.sunlight = vec3(vRayleighSunR[k].w, vMieSunG[k].w, vTransmittanceSunB[k].w);
+        s.air = Scattering(vRayleighSunR[k].xyz, vMieSunG[k].xyz, vTransmittanceSunB[k].xyz);
         // River water (not sea) is clipped to the basin in the fragment shader.
-        fRiverWater = riverWater && !belowSea ? 1 : 0;
-        fLevel = p.centreRel.w;
-        fDirection = direction;
-        fSpacing = spacing;
-        fInscatterRayleigh = vRayleighSunR[k].xyz;
-        fInscatterMie = vMieSunG[k].xyz;
-        fTransmittance = vTransmittanceSunB[k].xyz;
-        fSunlight = vec3(vRayleighSunR[k].w, vMieSunG[k].w, vTransmittanceSunB[k].w);
-        fFlow = flowTangent(p, vGridFlow[k].zw, direction);
-        fDetail = p.detail.xyz + local;
+        s.riverWater = riverWater && !belowSea;
+        s.level = p.centreRel.w;
+        s.spacing = spacing;
+        writeSurface(s);
         gl_Position = frame.viewProjection * vec4(position, 1.0);
         EmitVertex();
     }

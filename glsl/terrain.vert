@@ -5,21 +5,8 @@
 #include "terrain_vertex.glsl"
 #include "atmosphere.glsl"
 
-// What terrain.frag reads (the geometry shader writes the same locations in the water pass).
-layout(location = 0) out vec3 vPosition;    // camera-relative
-layout(location = 1) out vec3 vNormal;
-layout(location = 2) out vec4 vRiver;       // final height, water height, signed distance, river half width
-layout(location = 3) flat out int vRiverWater;
-layout(location = 4) flat out float vLevel;
-layout(location = 5) out vec3 vDirection;   // unit direction from the planet centre
-layout(location = 9) flat out float vSpacing;
-// The atmosphere between the camera and the vertex (atmosphere.glsl).
-layout(location = 10) out vec3 vInscatterRayleigh;
-layout(location = 11) out vec3 vInscatterMie;
-layout(location = 12) out vec3 vTransmittance;
-layout(location = 13) out vec3 vSunlight;   // the sunlight that reaches the vertex
-layout(location = 14) out vec3 vFlow;       // the river's flow: a tangent, unit length where the samples agree
-layout(location = 15) out vec3 vDetail;     // world position modulo DETAIL_PERIOD, precise near the camera
+#define TERRAIN_WRITER
+#include "terrain_interface.glsl"
 
 void main() {
     PatchInstance p = instances[gl_InstanceIndex];
@@ -42,25 +29,20 @@ void main() {
         captured[gl_InstanceIndex * (n * n + 6 * n) + gl_VertexIndex] = vec4(v.position, 1.0 + v.morph);
     }
 
-    vPosition = v.position;
+    SurfaceVertex s;
+    s.position = v.position;
+    s.normal = normal;
+    s.river = v.surface;
+    s.direction = v.direction;
     // The patch centre's world position (mod the period, from f64) plus the vertex's small offset from it.
-    vDetail = p.detail.xyz + v.local;
-    vNormal = normal;
-    vDirection = v.direction;
-    vRiver = v.surface;
-    vRiverWater = 0;
-    vLevel = p.centreRel.w;
-    vSpacing = p.centreDir.w;
-    vFlow = flowTangent(p, v.flow, v.direction);
-    vInscatterRayleigh = vec3(0.0);
-    vInscatterMie = vec3(0.0);
-    vTransmittance = vec3(1.0);
-    vSunlight = vec3(1.0);
-    if (atmosphereOn()) {
-        Scattering s = airTo(v.position, v.surface.x, v.direction, vSunlight);
-        vInscatterRayleigh = s.rayleigh;
-        vInscatterMie = s.mie;
-        vTransmittance = s.transmittance;
-    }
+    s.detail = p.detail.xyz + v.local;
+    s.flow = flowTangent(p, v.flow, v.direction);
+    s.sunlight = vec3(1.0);
+    s.air = Scattering(vec3(0.0), vec3(0.0), vec3(1.0));
+    if (atmosphereOn()) s.air = airTo(v.position, v.surface.x, v.direction, s.sunlight);
+    s.riverWater = false;
+    s.level = p.centreRel.w;
+    s.spacing = p.centreDir.w;
+    writeSurface(s);
     gl_Position = frame.viewProjection * vec4(v.position, 1.0);
 }

@@ -1,0 +1,63 @@
+// What terrain.frag reads, written by terrain.vert (terrain pass) and terrain.geom (water pass), packed into few
+// vec4 slots: lavapipe's draw module and triangle setup work per slot, per vertex and per triangle, on one thread
+// (docs/rendering.md, "The patch mesh and the shaders"). Writers define TERRAIN_WRITER before including it.
+// Needs atmosphere.glsl.
+
+#ifdef TERRAIN_WRITER
+#define TERRAIN_IO out
+#else
+#define TERRAIN_IO in
+#endif
+
+layout(location = 0) TERRAIN_IO vec4 ioPositionFlowX;   // camera-relative position; the flow's x
+layout(location = 1) TERRAIN_IO vec4 ioNormalFlowY;     // the surface normal; the flow's y
+layout(location = 2) TERRAIN_IO vec4 ioRiver;           // final height, water height, signed distance, half width
+layout(location = 3) TERRAIN_IO vec4 ioDirectionFlowZ;  // unit direction from the planet centre; the flow's z
+layout(location = 4) TERRAIN_IO vec4 ioDetailSunR;      // world position mod DETAIL_PERIOD; the sunlight's red
+layout(location = 5) TERRAIN_IO vec4 ioRayleighSunG;    // the air's inscattering (atmosphere.glsl); sunlight green
+layout(location = 6) TERRAIN_IO vec4 ioMieSunB;         // and Mie; the sunlight's blue
+layout(location = 7) TERRAIN_IO vec3 ioTransmittance;   // the air's transmittance from the eye
+layout(location = 8) flat TERRAIN_IO vec3 ioFlat;       // river water (1) or not (0), the level, the vertex spacing
+
+// One vertex of what terrain.frag reads.
+struct SurfaceVertex {
+    vec3 position;
+    vec3 normal;
+    vec4 river;
+    vec3 direction;
+    vec3 detail;
+    vec3 flow;            // the river's flow: a tangent, unit length where the samples agree
+    vec3 sunlight;        // the sunlight that reaches the vertex
+    Scattering air;
+    bool riverWater;
+    float level;
+    float spacing;
+};
+
+#ifdef TERRAIN_WRITER
+void writeSurface(SurfaceVertex v) {
+    ioPositionFlowX = vec4(v.position, v.flow.x);
+    ioNormalFlowY = vec4(v.normal, v.flow.y);
+    ioRiver = v.river;
+    ioDirectionFlowZ = vec4(v.direction, v.flow.z);
+    ioDetailSunR = vec4(v.detail, v.sunlight.r);
+    ioRayleighSunG = vec4(v.air.rayleigh, v.sunlight.g);
+    ioMieSunB = vec4(v.air.mie, v.sunlight.b);
+    ioTransmittance = v.air.transmittance;
+    ioFlat = vec3(v.riverWater ? 1.0 : 0.0, v.level, v.spacing);
+}
+#else
+#define fPosition ioPositionFlowX.xyz
+#define fNormal ioNormalFlowY.xyz
+#define fRiver ioRiver
+#define fDirection ioDirectionFlowZ.xyz
+#define fDetail ioDetailSunR.xyz
+#define fFlow vec3(ioPositionFlowX.w, ioNormalFlowY.w, ioDirectionFlowZ.w)
+#define fSunlight vec3(ioDetailSunR.w, ioRayleighSunG.w, ioMieSunB.w)
+#define fInscatterRayleigh ioRayleighSunG.xyz
+#define fInscatterMie ioMieSunB.xyz
+#define fTransmittance ioTransmittance
+#define fRiverWater ioFlat.x
+#define fLevel ioFlat.y
+#define fSpacing ioFlat.z
+#endif
