@@ -1,6 +1,8 @@
-// Shared by terrain.vert and water.vert (Section 8.2): a patch vertex's base height and river data, blended by
-// the lerp factor and morphed towards the parent, placed on the sphere relative to the camera.
+// Shared by terrain.vert, water.vert and vertex_cache.comp (Section 8.2): a patch vertex's base height and river
+// data, blended by the lerp factor and morphed towards the parent, placed on the sphere relative to the camera;
+// its normal and the air in front of it; and the vertex cache that holds all of it for a frame.
 #include "terrain_common.glsl"
+#include "atmosphere.glsl"
 
 // Texture coordinates of a grid position in the base-height texture, which has a border of HEIGHT_BORDER points
 // (planet::detail::BORDER) on each side.
@@ -82,10 +84,10 @@ vec3 positionAt(PatchInstance p, float height, vec3 offset) {
     return p.centreRel.xyz + p.centreDir.xyz * height + offset * (radius + height);
 }
 
-// One vertex of the patch mesh (gl_VertexIndex of instance gl_InstanceIndex), before normals and atmosphere.
+// One vertex of the patch mesh, before normals and atmosphere.
 struct TerrainVertex {
     vec3 position;   // camera-relative
-    vec3 local;      // from the patch centre (centreRel), small: the ground detail's coordinates build on it
+    vec3 local;      // position - centreRel: small, the ground detail's coordinates build on it
     vec3 direction;  // unit direction from the planet centre
     vec4 surface;    // final height, water height, signed distance, river half width
     vec2 flow;       // the water's flow in the patch frame
@@ -96,33 +98,135 @@ struct TerrainVertex {
     int edge;        // -1 surface, 0-3 edge skirts, 4-5 midline skirts
 };
 
-TerrainVertex terrainVertex(PatchInstance p) {
+// The grid point of mesh vertex `id` (render/mesh.rs: the grid, then six skirts of n vertices) and its skirt.
+ivec2 meshGrid(int id, out int edge) {
     int n = int(frame.planet.y);
-    int id = gl_VertexIndex;
-    ivec2 ij;
-    TerrainVertex v;
-    v.edge = -1;
-    if (id < n * n) {
-        ij = ivec2(id % n, id / n);
-    } else {
-        v.edge = (id - n * n) / n;
-        int k = (id - n * n) % n;
-        int m = (n - 1) / 2;
-        ivec2 along[6] = ivec2[](ivec2(k, 0), ivec2(k, n - 1), ivec2(0, k), ivec2(n - 1, k), ivec2(m, k), ivec2(k, m));
-        ij = along[v.edge];
-    }
-    v.grid = vec2(ij);
-    // Morph: odd grid coordinates slide towards the even neighbour below, so that fully morphed the mesh is the
-    // parent's (whose points keep their heights at every level); the distance is the unmorphed vertex's, from its
-    // base height, which neighbouring patches share bit for bit.
-    v.morph = morphFactor(p, length(positionAt(p, baseAt(p, v.grid), directionOffset(p, v.grid))));
-    v.morphed = v.grid - mod(v.grid, 2.0) * v.morph;
-    v.surface = surfaceAt(p, v.morphed, v.morph, v.flow);
-    v.offset = directionOffset(p, v.morphed);
+    edge = -1;
+    if (id < n * n) return ivec2(id % n, id / n);
+    edge = (id - n * n) / n;
+    int k = (id - n * n) % n;
+    int m = (n - 1) / 2;
+    ivec2 along[6] = ivec2[](ivec2(k, 0), ivec2(k, n - 1), ivec2(0, k), ivec2(n - 1, k), ivec2(m, k), ivec2(k, m));
+    return along[edge];
+}
+
+// Morph: odd grid coordinates slide towards the even neighbour below, so that fully morphed the mesh is the
+// parent's (whose points keep their heights at every level).
+vec2 morphedGrid(vec2 grid, float morph) { return grid - mod(grid, 2.0) * morph; }
+
+// Places a vertex of height `height` at the morphed grid position (offset: directionOffset there); skirts hang
+// texRect.w below.
+void place(PatchInstance p, inout TerrainVertex v, float height) {
     v.direction = normalize(p.centreDir.xyz + v.offset);
-    if (v.edge >= 0) v.surface.x -= p.texRect.w;
-    float height = v.surface.x;
+    if (v.edge >= 0) height -= p.texRect.w;
+    v.surface.x = height;
     v.position = positionAt(p, height, v.offset);
     v.local = p.centreDir.xyz * height + v.offset * (frame.planet.x + height);
+}
+
+// Mesh vertex `id` of `p`, computed from the patch textures.
+TerrainVertex terrainVertex(PatchInstance p, int id) {
+    TerrainVertex v;
+    v.grid = vec2(meshGrid(id, v.edge));
+    // The morph distance is the unmorphed vertex's, from its base height, which neighbouring patches share bit for
+    // bit.
+    v.morph = morphFactor(p, length(positionAt(p, baseAt(p, v.grid), directionOffset(p, v.grid))));
+    v.morphed = morphedGrid(v.grid, v.morph);
+    v.surface = surfaceAt(p, v.morphed, v.morph, v.flow);
+    v.offset = directionOffset(p, v.morphed);
+    place(p, v, v.surface.x);
     return v;
 }
+
+// What a vertex's passes need beyond its place: its normal and the air between the eye and it.
+struct VertexShading {
+    vec3 normal;
+    vec3 sunlight;   // the sunlight that reaches the vertex
+    Scattering air;
+};
+
+// Normal from the four neighbours (one parent spacing apart when fully morphed); at the patch edges the neighbour
+// outside is the base texture's border point (the neighbouring patch's vertex, same bits), so both sides of a seam
+// get the same normal; without `withNormal`, the direction. The atmosphere from atmosphere.glsl.
+VertexShading shadeVertex(PatchInstance p, TerrainVertex v, bool withNormal) {
+    VertexShading s;
+    s.normal = v.direction;
+    if (withNormal) {
+        vec3 neighbour[4];
+        vec2 offsets[4] = vec2[](vec2(1, 0), vec2(-1, 0), vec2(0, 1), vec2(0, -1));
+        for (int k = 0; k < 4; ++k) {
+            vec2 g = v.morphed + offsets[k] * (1.0 + v.morph);
+            neighbour[k] = positionAt(p, heightAt(p, g, v.morph), directionOffset(p, g));
+        }
+        s.normal = normalize(cross(neighbour[0] - neighbour[1], neighbour[2] - neighbour[3]));
+        if (dot(s.normal, v.direction) < 0.0) s.normal = -s.normal;
+    }
+    s.sunlight = vec3(1.0);
+    s.air = Scattering(vec3(0.0), vec3(0.0), vec3(1.0));
+    if (atmosphereOn()) s.air = airTo(v.position, v.surface.x, v.direction, s.sunlight);
+    return s;
+}
+
+// Beyond the thesis (docs/rendering.md, "The vertex cache"): every grid vertex of every drawn patch, computed once
+// a frame by vertex_cache.comp, which lavapipe runs on all its threads, and read by both passes' vertex shaders,
+// which it runs on one. Skirts read their grid point's. The normal, the height and the river in f32, the rest in
+// f16 pairs.
+struct CachedVertex {
+    vec4 normalMorph;  // the normal; the morph factor
+    vec4 surface;      // height (of the grid point), water height, signed distance, half width
+    uvec4 shading;     // the flow, sunlight.rg, sunlight.b and rayleigh.r, rayleigh.gb
+    uvec4 air;         // mie.rg, mie.b and transmittance.r, transmittance.gb; w unused (std430 pads to 16 bytes)
+};
+
+#ifdef VERTEX_CACHE_WRITER
+layout(set = 1, binding = 2, std430) writeonly buffer VertexCache { CachedVertex cachedVertices[]; };
+#else
+layout(set = 1, binding = 2, std430) readonly buffer VertexCache { CachedVertex cachedVertices[]; };
+#endif
+
+// The cache index of instance `p` (instance.detail.w), or -1 where its vertices are computed in the vertex shader.
+int cacheIndex(PatchInstance p) { return int(p.detail.w); }
+
+#ifdef VERTEX_CACHE_WRITER
+void storeVertex(uint index, TerrainVertex v, VertexShading s) {
+    CachedVertex c;
+    c.normalMorph = vec4(s.normal, v.morph);
+    c.surface = v.surface;
+    c.shading = uvec4(packHalf2x16(v.flow), packHalf2x16(s.sunlight.rg),
+                      packHalf2x16(vec2(s.sunlight.b, s.air.rayleigh.r)), packHalf2x16(s.air.rayleigh.gb));
+    c.air = uvec4(packHalf2x16(s.air.mie.rg), packHalf2x16(vec2(s.air.mie.b, s.air.transmittance.r)),
+                  packHalf2x16(s.air.transmittance.gb), 0u);
+    cachedVertices[index] = c;
+}
+#else
+// Mesh vertex `id` of `p` from the cache: its grid point's, placed as terrainVertex places it.
+void loadVertex(PatchInstance p, int id, out TerrainVertex v, out VertexShading s) {
+    v.grid = vec2(meshGrid(id, v.edge));
+    int n = int(frame.planet.y);
+    CachedVertex c = cachedVertices[cacheIndex(p) * n * n + int(v.grid.y) * n + int(v.grid.x)];
+    v.morph = c.normalMorph.w;
+    v.morphed = morphedGrid(v.grid, v.morph);
+    v.offset = directionOffset(p, v.morphed);
+    v.surface = c.surface;
+    v.flow = unpackHalf2x16(c.shading.x);
+    place(p, v, c.surface.x);
+    s.normal = c.normalMorph.xyz;
+    vec2 sunBRayleighR = unpackHalf2x16(c.shading.z);
+    vec2 mieBTransmittanceR = unpackHalf2x16(c.air.y);
+    s.sunlight = vec3(unpackHalf2x16(c.shading.y), sunBRayleighR.x);
+    s.air.rayleigh = vec3(sunBRayleighR.y, unpackHalf2x16(c.shading.w));
+    s.air.mie = vec3(unpackHalf2x16(c.air.x), mieBTransmittanceR.x);
+    s.air.transmittance = vec3(mieBTransmittanceR.y, unpackHalf2x16(c.air.z));
+}
+
+// Mesh vertex gl_VertexIndex of `p` and its shading: from the cache where the patch has an entry, else computed
+// here (the thesis's way, Section 8.2), with the normal if `withNormal`.
+void meshVertex(PatchInstance p, bool withNormal, out TerrainVertex v, out VertexShading s) {
+    if (cacheIndex(p) >= 0) {
+        loadVertex(p, gl_VertexIndex, v, s);
+    } else {
+        v = terrainVertex(p, gl_VertexIndex);
+        s = shadeVertex(p, v, withNormal);
+    }
+}
+#endif

@@ -2,9 +2,8 @@
 // Section 8.4: the water pass's vertex, handed to the geometry shader (terrain.geom) that spawns the water
 // triangles. Packed into few vec4s: Mesa's draw module looks up every geometry-shader input of every vertex of every
 // triangle by a linear search over the vertex outputs, which made the unpacked interface the largest cost of the
-// frame on lavapipe (docs/rendering.md, "The water pass").
+// frame on lavapipe (docs/rendering.md, "The patch mesh and the shaders").
 #include "terrain_vertex.glsl"
-#include "atmosphere.glsl"
 
 layout(location = 0) out vec4 vLocalInstance;    // xyz: TerrainVertex.local; w: the instance
 layout(location = 1) out vec4 vRiver;            // final height, water height, signed distance, river half width
@@ -18,16 +17,15 @@ layout(location = 6) out vec4 vTransmittanceSunB;
 
 void main() {
     PatchInstance p = instances[gl_InstanceIndex];
-    TerrainVertex v = terrainVertex(p);
+    TerrainVertex v;
+    VertexShading s;
+    meshVertex(p, false, v, s);
     vLocalInstance = vec4(v.local, float(gl_InstanceIndex));
     vRiver = v.surface;
     vDirectionEdge = vec4(v.direction, float(v.edge));
     vGridFlow = vec4(v.grid, v.flow);
-    vec3 sunlight = vec3(1.0);
-    Scattering s = Scattering(vec3(0.0), vec3(0.0), vec3(1.0));
-    if (atmosphereOn()) s = airTo(v.position, v.surface.x, v.direction, sunlight);
-    vRayleighSunR = vec4(s.rayleigh, sunlight.r);
-    vMieSunG = vec4(s.mie, sunlight.g);
-    vTransmittanceSunB = vec4(s.transmittance, sunlight.b);
+    vRayleighSunR = vec4(s.air.rayleigh, s.sunlight.r);
+    vMieSunG = vec4(s.air.mie, s.sunlight.g);
+    vTransmittanceSunB = vec4(s.air.transmittance, s.sunlight.b);
     gl_Position = frame.viewProjection * vec4(v.position, 1.0);
 }

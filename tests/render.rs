@@ -349,3 +349,34 @@ fn the_water_moves_with_time_and_the_land_does_not() {
     assert!(moved > 100, "only {moved} pixels of water moved");
     common::assert_no_validation_errors(ctx);
 }
+
+/// Beyond the thesis: the vertex cache (vertices computed once a frame in a compute pass) draws what the vertex
+/// shaders compute when it is off (the thesis's way), up to its f16 atmosphere.
+#[test]
+fn the_vertex_cache_draws_what_the_vertex_shaders_compute() {
+    let Some(ctx) = common::gpu() else { return };
+    let size = [256, 144];
+    for preset in [Preset::Orbit, Preset::River, Preset::Ground] {
+        let camera = preset_camera(preset, size[0] as f64 / size[1] as f64);
+        let at = |cached: bool| {
+            render_with(ctx, &camera, size, |r| {
+                r.water_mode = WaterMode::Geometry;
+                r.cache_vertices = cached;
+            })
+        };
+        let (cached, computed) = (at(true), at(false));
+        let largest = cached
+            .pixels()
+            .zip(computed.pixels())
+            .flat_map(|(p, q)| (0..3).map(|c| (p.0[c] as i32 - q.0[c] as i32).abs()))
+            .max()
+            .unwrap();
+        let (mean, _) = compare(&cached, &computed);
+        eprintln!("{preset:?}: mean difference {mean:.4}, largest {largest}");
+        assert!(
+            mean < 0.05 && largest <= 8,
+            "{preset:?}: the cached vertices draw another image (mean difference {mean:.4}, largest {largest})"
+        );
+    }
+    common::assert_no_validation_errors(ctx);
+}

@@ -111,6 +111,7 @@ pub struct FlightReport {
     pub parent_reuse: bool,
     pub frames_in_flight: usize,
     pub atmosphere: bool,
+    pub vertex_cache: bool,
     pub lod_rule: crate::config::LodRule,
     pub river_model: crate::config::RiverModel,
     pub radius: f64,
@@ -152,6 +153,8 @@ pub struct FlightOptions {
     pub lod_rule: Option<crate::config::LodRule>,
     /// The atmosphere (`false`: the constant haze).
     pub atmosphere: bool,
+    /// The vertex cache (`false`: vertices computed in the vertex shaders, as the thesis).
+    pub vertex_cache: bool,
 }
 
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
@@ -186,6 +189,7 @@ fn fly(
     renderer.morphing = options.morphing;
     renderer.parent_reuse = options.parent_reuse;
     renderer.atmosphere_on = options.atmosphere;
+    renderer.cache_vertices = options.vertex_cache;
     renderer.set_frames_in_flight(options.frames_in_flight)?;
     if let Some(rule) = options.lod_rule {
         renderer.lod_rule = rule;
@@ -474,6 +478,7 @@ pub fn flight_bench(
         descent: options.descent,
         morphing: options.morphing,
         atmosphere: options.atmosphere,
+        vertex_cache: options.vertex_cache,
         parent_reuse: options.parent_reuse,
         frames_in_flight: options.frames_in_flight,
         lod_rule: options

@@ -93,6 +93,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             frames_in_flight,
             frames,
             atmosphere,
+            vertex_cache,
             speed,
             size,
             no_kernel_comparison,
@@ -132,6 +133,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 lod_rule,
                 frames_in_flight,
                 atmosphere: atmosphere.on(),
+                vertex_cache: vertex_cache.on(),
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {

@@ -295,6 +295,10 @@ pub enum BenchCommand {
         /// The atmosphere (beyond the thesis); `off`: a constant haze, as before it.
         #[arg(long, value_enum, default_value = "on")]
         atmosphere: Switch,
+        /// The vertex cache (beyond the thesis): the drawn patches' vertices computed once a frame in a compute
+        /// pass; `off`: in the vertex shaders of both passes, as the thesis.
+        #[arg(long, value_enum, default_value = "on")]
+        vertex_cache: Switch,
         /// Camera speed factor (the stress test uses 25).
         #[arg(long, default_value_t = 1.0, value_parser = positive_number, allow_hyphen_values = true)]
         speed: f64,

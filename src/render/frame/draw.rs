@@ -7,7 +7,9 @@ use std::collections::HashMap;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
 
-use super::{FrameStats, Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT};
+use super::{
+    vertex_cache::VertexCache, FrameStats, Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT,
+};
 use crate::{
     gpu::{
         pipeline::RenderTarget, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
@@ -39,6 +41,7 @@ pub struct PatchInstance {
     tex_rect: [f32; 4],
     slots: [i32; 4],
     morph: [f32; 4],
+    /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
     detail: [f32; 4],
 }
 
@@ -89,6 +92,8 @@ impl VertexCapture {
 /// What the recorded draws leave for after the frame: the vertex capture buffer and whose vertices it holds.
 pub(super) struct Drawn {
     capture: Option<Buffer>,
+    /// The instances before the terrain pass's (the vertex cache's), whose capture slots stay empty.
+    first_terrain_instance: usize,
     instance_patches: Vec<PatchId>,
 }
 
@@ -112,7 +117,7 @@ impl Drawn {
             patches: self
                 .instance_patches
                 .iter()
-                .zip(p.chunks(per))
+                .zip(p.chunks(per).skip(self.first_terrain_instance))
                 .map(|(patch, v)| (*patch, v.to_vec()))
                 .collect(),
         })
@@ -222,7 +227,18 @@ impl Renderer<'_> {
             let distance = |p: &PatchId| camera.position.distance_squared(p.center() * radius);
             distance(&a.2).total_cmp(&distance(&b.2))
         });
-        let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 3);
+        // The drawn patches first, once each: the vertex cache's entries (instance k fills entry k).
+        let cached = if self.cache_vertices {
+            VertexCache::patches(drawn.len(), n)
+        } else {
+            0
+        };
+        for (k, (instance, _, _)) in drawn.iter_mut().enumerate() {
+            instance.detail[3] = if k < cached { k as f32 } else { -1.0 };
+        }
+        let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 4);
+        instances.extend(drawn.iter().map(|(i, _, _)| *i));
+        let first_terrain_instance = instances.len();
         let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
         let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
         for (q, range) in quadrant_instances.iter_mut().enumerate() {
@@ -247,9 +263,10 @@ impl Renderer<'_> {
             buffer.write(0, &instances)?;
             buffer
         };
-        // Vertex capture (tests): one slot per terrain instance and mesh vertex, zero where nothing was drawn.
+        // Vertex capture (tests): one slot per instance and mesh vertex, zero where nothing was drawn.
         let capture = if self.capture_vertices {
-            let size = (instance_patches.len().max(1) * mesh_vertices(n) as usize * 16) as u64;
+            let slots = first_terrain_instance + instance_patches.len();
+            let size = (slots.max(1) * mesh_vertices(n) as usize * 16) as u64;
             let buffer = ctx.create_buffer(&BufferDesc {
                 name: "vertex capture",
                 size,
@@ -269,11 +286,13 @@ impl Renderer<'_> {
         } else {
             None
         };
+        let vertex_cache = VertexCache::buffer(ctx, cached, n)?;
         let instance_set = rec.buffer_set(
             &self.instance_layout,
             &[
                 &instance_buffer,
                 capture.as_ref().unwrap_or(&self.no_capture),
+                &vertex_cache,
             ],
         )?;
         rec.free_after_completion(instance_buffer);
@@ -319,6 +338,13 @@ impl Renderer<'_> {
                 sky.map_or(0.0, |s| s.height),
             ],
         };
+        let sets = [self.bindless.set, instance_set];
+        let push = bytemuck::bytes_of(&push);
+        let scope = self.frames.profiler().begin(rec, "vertices")?;
+        self.vertex_cache
+            .record(rec, (&sets, push), &vertex_cache, cached, n);
+        self.frames.profiler().end(rec, scope);
+        rec.free_after_completion(vertex_cache);
         rec.raw_image_transition(
             target.color_image,
             vk::ImageAspectFlags::COLOR,
@@ -351,8 +377,6 @@ impl Renderer<'_> {
             ),
         );
         rec.begin_rendering(target, true);
-        let sets = [self.bindless.set, instance_set];
-        let push = bytemuck::bytes_of(&push);
         let scope = self.frames.profiler().begin(rec, "terrain")?;
         let terrain = if self.wireframe_on {
             &self.wireframe
@@ -407,6 +431,7 @@ impl Renderer<'_> {
         }
         Ok(Drawn {
             capture,
+            first_terrain_instance,
             instance_patches,
         })
     }

@@ -8,6 +8,7 @@ mod inflight;
 mod plan;
 mod sky;
 mod upload;
+mod vertex_cache;
 
 use std::{collections::BTreeMap, time::Instant};
 
@@ -154,6 +155,7 @@ pub struct Renderer<'w> {
     instance_layout: BufferSetLayout,
     /// Bound in place of a capture buffer when vertices are not captured.
     no_capture: Buffer,
+    vertex_cache: vertex_cache::VertexCache,
     indices: Buffer,
     quadrant_ranges: [std::ops::Range<u32>; 4],
     all_indices: std::ops::Range<u32>,
@@ -185,6 +187,9 @@ pub struct Renderer<'w> {
     /// Beyond the thesis: rippled water carried by the rivers' flow, foam at banks and shores; `false`: still,
     /// flat water as the thesis draws it (Section 8.4).
     pub flowing_water: bool,
+    /// Beyond the thesis: the drawn patches' vertices computed once a frame in a compute pass and read by both
+    /// passes (render/frame/vertex_cache.rs); `false`: computed in the vertex shaders, as the thesis.
+    pub cache_vertices: bool,
     /// Seconds of animation: how far the water has flowed.
     pub time: f32,
     /// Beyond the thesis: patches selected by their nearest point and morphed towards their parent before a
@@ -227,7 +232,8 @@ impl<'w> Renderer<'w> {
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
         let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
         let refiner = HeightRefiner::new(ctx, &bindless, n)?;
-        let instance_layout = BufferSetLayout::new(ctx, 2, "patch instances and vertex capture")?;
+        let instance_layout =
+            BufferSetLayout::new(ctx, 3, "patch instances, vertex capture and vertex cache")?;
         let no_capture = ctx.create_buffer(&BufferDesc {
             name: "no vertex capture",
             size: 16,
@@ -235,6 +241,7 @@ impl<'w> Renderer<'w> {
             location: MemoryLocation::GpuOnly,
         })?;
         let layouts = [bindless.layout, instance_layout.layout];
+        let vertex_cache = vertex_cache::VertexCache::new(ctx, &layouts)?;
         // The terrain is drawn per quadrant without a geometry shader; the water pass has the geometry shader that
         // spawns water triangles (docs/rendering.md).
         let pipeline = |name: &str, water: bool, wireframe: bool| {
@@ -242,7 +249,11 @@ impl<'w> Renderer<'w> {
                 ctx,
                 &GraphicsDesc {
                     name,
-                    vertex: if water { shaders::WATER_VERT } else { shaders::TERRAIN_VERT },
+                    vertex: if water {
+                        shaders::WATER_VERT
+                    } else {
+                        shaders::TERRAIN_VERT
+                    },
                     geometry: water.then_some(shaders::TERRAIN_GEOM),
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
@@ -304,6 +315,7 @@ impl<'w> Renderer<'w> {
             sky,
             instance_layout,
             no_capture,
+            vertex_cache,
             indices,
             quadrant_ranges: quadrants,
             all_indices: 0..mesh.len() as u32,
@@ -330,6 +342,7 @@ impl<'w> Renderer<'w> {
             freeze_lod: false,
             atmosphere_on: true,
             flowing_water: true,
+            cache_vertices: true,
             time: 0.0,
             morphing: true,
             parent_reuse: true,
@@ -501,6 +514,7 @@ impl<'w> Renderer<'w> {
             sky.destroy(ctx, &mut self.bindless);
         }
         self.instance_layout.destroy(ctx);
+        self.vertex_cache.destroy(ctx);
         ctx.retire_buffer(self.no_capture);
         let _ = ctx.wait_idle();
         self.bindless.destroy(ctx);

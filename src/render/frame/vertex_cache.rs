@@ -1,0 +1,94 @@
+//! Beyond the thesis: the vertex cache (docs/rendering.md, "The vertex cache"). Once a frame, a compute pass
+//! (glsl/vertex_cache.comp) computes every grid vertex of every drawn patch as the thesis's vertex shader would
+//! (Section 8.2: heights blended with the river data, morphed, placed on the sphere, its normal and, beyond the
+//! thesis, the air in front of it); the terrain and water passes' vertex shaders then read it. Lavapipe runs compute
+//! on all its threads but vertex shaders on one, and both passes shade the same vertices, so each is computed once,
+//! in parallel. Patches beyond the cache's size, or all with `Renderer::vertex_cache` off, compute their vertices
+//! in the vertex shaders, the thesis's way.
+
+use super::FramePush;
+use crate::{
+    gpu::{
+        pipeline::ComputePipeline, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
+        Recorder,
+    },
+    shaders,
+};
+
+/// Bytes of one cached vertex (`CachedVertex` in glsl/terrain_vertex.glsl).
+const VERTEX_BYTES: u64 = 64;
+
+/// The most bytes one frame's cache takes (64 MiB: 963 patches of 33 x 33 vertices); patches beyond it are
+/// computed in the vertex shaders.
+const MAX_BYTES: u64 = 64 << 20;
+
+/// Grid vertices per workgroup (`local_size_x` of vertex_cache.comp).
+const WORKGROUP: u32 = 64;
+
+pub(super) struct VertexCache {
+    pipeline: ComputePipeline,
+}
+
+impl VertexCache {
+    pub(super) fn new(
+        ctx: &Context,
+        layouts: &[vk::DescriptorSetLayout],
+    ) -> Result<Self, GpuError> {
+        let pipeline = ComputePipeline::new(
+            ctx,
+            shaders::VERTEX_CACHE_COMP,
+            "vertex cache",
+            layouts,
+            std::mem::size_of::<FramePush>() as u32,
+            &[],
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    /// How many of `drawn` patches of `n` x `n` vertices one frame caches.
+    pub(super) fn patches(drawn: usize, n: u32) -> usize {
+        drawn.min((MAX_BYTES / (n as u64 * n as u64 * VERTEX_BYTES)) as usize)
+    }
+
+    /// A cache for `patches` patches of `n` x `n` vertices (at least one vertex's bytes, so it can be bound).
+    pub(super) fn buffer(ctx: &Context, patches: usize, n: u32) -> Result<Buffer, GpuError> {
+        ctx.create_buffer(&BufferDesc {
+            name: "vertex cache",
+            size: (patches as u64 * n as u64 * n as u64 * VERTEX_BYTES).max(VERTEX_BYTES),
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuOnly,
+        })
+    }
+
+    /// Records the pass that fills `cache` for instances 0 .. `patches` (which `sets` bind), and makes it visible
+    /// to the vertex shaders.
+    pub(super) fn record(
+        &self,
+        rec: &mut Recorder,
+        (sets, push): (&[vk::DescriptorSet], &[u8]),
+        cache: &Buffer,
+        patches: usize,
+        n: u32,
+    ) {
+        if patches == 0 {
+            return;
+        }
+        rec.dispatch(
+            &self.pipeline,
+            sets,
+            push,
+            [(n * n).div_ceil(WORKGROUP), patches as u32, 1],
+        );
+        rec.buffer_barrier(
+            cache,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::VERTEX_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_READ,
+        );
+    }
+
+    pub(super) fn destroy(self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+}
