@@ -2,17 +2,59 @@
 // Beyond the thesis (docs/rendering.md, "The vertex cache"): one frame's grid vertices of every drawn patch, as
 // terrain.vert and water.vert would compute them (terrain_vertex.glsl), once, on all of the device's threads.
 // Workgroup (x, k): grid vertices 64x .. 64x + 63 of drawn patch k, which is instance k (render/frame/draw.rs puts
-// the drawn patches first).
+// the drawn patches first). On the way it finds the drawn quadrants with water, the only ones the water pass
+// draws: its four indirect draws per patch start with no instance, and a quadrant that has a vertex in a river's
+// basin (unless rivers are painted) or below sea level gets one. The geometry shader still decides per triangle
+// (Section 8.4); a dry quadrant would emit nothing.
 #define VERTEX_CACHE_WRITER
 #include "terrain_vertex.glsl"
 
 layout(local_size_x = 64) in;
 
+// VkDrawIndexedIndirectCommand, four per patch (render/frame/vertex_cache.rs writes all but instanceCount).
+struct DrawCommand {
+    uint indexCount;
+    uint instanceCount;
+    uint firstIndex;
+    int vertexOffset;
+    uint firstInstance;
+};
+layout(set = 1, binding = 3, std430) buffer WaterDraws { DrawCommand waterDraws[]; };
+
+shared uint wetQuadrants;
+
+// The quadrants (bit 0: +i half, bit 1: +j half, as render/mesh.rs) of the cells around grid point `ij`.
+uint quadrantsAround(ivec2 ij, int n) {
+    int m = (n - 1) / 2;
+    uint bits = 0u;
+    for (int dj = -1; dj <= 0; ++dj) {
+        for (int di = -1; di <= 0; ++di) {
+            ivec2 cell = ij + ivec2(di, dj);
+            if (all(greaterThanEqual(cell, ivec2(0))) && all(lessThanEqual(cell, ivec2(n - 2)))) {
+                bits |= 1u << (int(cell.x >= m) | (int(cell.y >= m) << 1));
+            }
+        }
+    }
+    return bits;
+}
+
 void main() {
     int n = int(frame.planet.y);
     int id = int(gl_GlobalInvocationID.x);
-    if (id >= n * n) return;
     PatchInstance p = instances[gl_WorkGroupID.y];
-    TerrainVertex v = terrainVertex(p, id);
-    storeVertex(uint(cacheIndex(p) * n * n + id), v, shadeVertex(p, v, true));
+    int entry = cacheIndex(p);
+    if (gl_LocalInvocationIndex == 0) wetQuadrants = 0u;
+    barrier();
+    if (id < n * n) {
+        TerrainVertex v = terrainVertex(p, id);
+        storeVertex(uint(entry * n * n + id), v, shadeVertex(p, v, true));
+        bool river = waterMode() != WATER_PAINTED && abs(v.surface.z) < v.surface.w;
+        bool sea = v.surface.x < frame.sun.w;
+        if (river || sea) atomicOr(wetQuadrants, quadrantsAround(ivec2(v.grid), n));
+    }
+    barrier();
+    uint q = gl_LocalInvocationIndex;
+    if (q < 4 && (wetQuadrants & uint(p.slots.z) & (1u << q)) != 0u) {
+        atomicOr(waterDraws[entry * 4 + int(q)].instanceCount, 1u);
+    }
 }

@@ -61,6 +61,10 @@ pub fn query(
         ("geometryShader", b(core.geometry_shader)),
         ("fillModeNonSolid (wireframe)", b(core.fill_mode_non_solid)),
         (
+            "multiDrawIndirect + drawIndirectFirstInstance (water culled per quadrant)",
+            b(core.multi_draw_indirect) && b(core.draw_indirect_first_instance),
+        ),
+        (
             "vertexPipelineStoresAndAtomics (vertex capture)",
             b(core.vertex_pipeline_stores_and_atomics),
         ),
@@ -149,6 +153,8 @@ impl EnabledFeatures {
             core: vk::PhysicalDeviceFeatures::default()
                 .geometry_shader(true)
                 .fill_mode_non_solid(true)
+                .multi_draw_indirect(true)
+                .draw_indirect_first_instance(true)
                 .vertex_pipeline_stores_and_atomics(true),
             v12: vk::PhysicalDeviceVulkan12Features::default()
                 .descriptor_indexing(true)

@@ -502,19 +502,10 @@ impl Recorder<'_> {
         if range.is_empty() || instances.is_empty() {
             return;
         }
-        let stages = vk::ShaderStageFlags::VERTEX
-            | vk::ShaderStageFlags::GEOMETRY
-            | vk::ShaderStageFlags::FRAGMENT;
-        self.bind(
-            vk::PipelineBindPoint::GRAPHICS,
-            (pipeline.pipeline, pipeline.layout),
-            sets,
-            (stages, push),
-        );
+        self.bind_draw(pipeline, (sets, push), indices);
         let device = &self.ctx().device;
         // SAFETY: recording inside a rendering scope; the pipeline is bound.
         unsafe {
-            device.cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32);
             device.cmd_draw_indexed(
                 self.cmd,
                 range.end - range.start,
@@ -524,5 +515,57 @@ impl Recorder<'_> {
                 instances.start,
             );
         }
+    }
+
+    /// Draws `count` indexed draws whose parameters the GPU wrote into `commands` (`VkDrawIndexedIndirectCommand`s
+    /// from offset 0), with `pipeline`, `sets` and `push` as [`Recorder::draw_indexed`].
+    pub fn draw_indexed_indirect(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        (sets, push): (&[vk::DescriptorSet], &[u8]),
+        indices: &super::Buffer,
+        commands: &super::Buffer,
+        count: u32,
+    ) {
+        if count == 0 {
+            return;
+        }
+        self.bind_draw(pipeline, (sets, push), indices);
+        let device = &self.ctx().device;
+        // SAFETY: recording inside a rendering scope; the pipeline is bound; multiDrawIndirect is enabled.
+        unsafe {
+            device.cmd_draw_indexed_indirect(
+                self.cmd,
+                commands.raw,
+                0,
+                count,
+                std::mem::size_of::<vk::DrawIndexedIndirectCommand>() as u32,
+            );
+        }
+    }
+
+    /// Binds a graphics pipeline with its sets and push constants (for every stage that may read them), and the
+    /// u32 index buffer `indices`.
+    fn bind_draw(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        (sets, push): (&[vk::DescriptorSet], &[u8]),
+        indices: &super::Buffer,
+    ) {
+        let stages = vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::GEOMETRY
+            | vk::ShaderStageFlags::FRAGMENT;
+        self.bind(
+            vk::PipelineBindPoint::GRAPHICS,
+            (pipeline.pipeline, pipeline.layout),
+            sets,
+            (stages, push),
+        );
+        // SAFETY: recording; the buffer holds u32 indices.
+        unsafe {
+            self.ctx()
+                .device
+                .cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32)
+        };
     }
 }

@@ -250,8 +250,16 @@ impl Renderer<'_> {
             }
             *range = first..instances.len() as u32;
         }
+        // Cached patches draw their water through the cache pass's indirect draws (instance k is patch k); the
+        // rest as instances of their own.
         let first = instances.len() as u32;
-        instances.extend(drawn.iter().filter(|(_, wet, _)| *wet).map(|(i, _, _)| *i));
+        instances.extend(
+            drawn
+                .iter()
+                .skip(cached)
+                .filter(|(_, wet, _)| *wet)
+                .map(|(i, _, _)| *i),
+        );
         let water_instances = first..instances.len() as u32;
         let instance_buffer = {
             let mut buffer = ctx.create_buffer(&BufferDesc {
@@ -287,12 +295,14 @@ impl Renderer<'_> {
             None
         };
         let vertex_cache = VertexCache::buffer(ctx, cached, n)?;
+        let water_draws = VertexCache::water_draws(ctx, cached, &self.quadrant_ranges)?;
         let instance_set = rec.buffer_set(
             &self.instance_layout,
             &[
                 &instance_buffer,
                 capture.as_ref().unwrap_or(&self.no_capture),
                 &vertex_cache,
+                &water_draws,
             ],
         )?;
         rec.free_after_completion(instance_buffer);
@@ -342,7 +352,7 @@ impl Renderer<'_> {
         let push = bytemuck::bytes_of(&push);
         let scope = self.frames.profiler().begin(rec, "vertices")?;
         self.vertex_cache
-            .record(rec, (&sets, push), &vertex_cache, cached, n);
+            .record(rec, (&sets, push), (&vertex_cache, &water_draws), cached, n);
         self.frames.profiler().end(rec, scope);
         rec.free_after_completion(vertex_cache);
         rec.raw_image_transition(
@@ -397,6 +407,13 @@ impl Renderer<'_> {
         self.frames.profiler().end(rec, scope);
         let scope = self.frames.profiler().begin(rec, "water")?;
         if !self.wireframe_on {
+            rec.draw_indexed_indirect(
+                &self.water,
+                (&sets, push),
+                &self.indices,
+                &water_draws,
+                4 * cached as u32,
+            );
             rec.draw_indexed(
                 &self.water,
                 &sets,
@@ -406,6 +423,7 @@ impl Renderer<'_> {
                 water_instances,
             );
         }
+        rec.free_after_completion(water_draws);
         self.frames.profiler().end(rec, scope);
         if let (true, Some(sky)) = (draw_sky, &self.sky) {
             let scope = self.frames.profiler().begin(rec, "sky")?;

@@ -232,8 +232,11 @@ impl<'w> Renderer<'w> {
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
         let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
         let refiner = HeightRefiner::new(ctx, &bindless, n)?;
-        let instance_layout =
-            BufferSetLayout::new(ctx, 3, "patch instances, vertex capture and vertex cache")?;
+        let instance_layout = BufferSetLayout::new(
+            ctx,
+            4,
+            "patch instances, vertex capture, vertex cache, water draws",
+        )?;
         let no_capture = ctx.create_buffer(&BufferDesc {
             name: "no vertex capture",
             size: 16,

@@ -5,6 +5,12 @@
 //! on all its threads but vertex shaders on one, and both passes shade the same vertices, so each is computed once,
 //! in parallel. Patches beyond the cache's size, or all with `Renderer::vertex_cache` off, compute their vertices
 //! in the vertex shaders, the thesis's way.
+//!
+//! The pass also finds which drawn quadrants have water: the water pass draws a cached patch through four
+//! indirect draws, one per quadrant, that the pass gives an instance only where a vertex is in a river's basin or
+//! below sea level.
+
+use std::{mem::size_of, ops::Range};
 
 use super::FramePush;
 use crate::{
@@ -60,13 +66,38 @@ impl VertexCache {
         })
     }
 
-    /// Records the pass that fills `cache` for instances 0 .. `patches` (which `sets` bind), and makes it visible
-    /// to the vertex shaders.
+    /// The water pass's indirect draws of `patches` cached patches: per patch (instance k) its four quadrants'
+    /// index ranges, with no instance until the cache's pass finds water there. At least one draw's bytes.
+    pub(super) fn water_draws(
+        ctx: &Context,
+        patches: usize,
+        quadrants: &[Range<u32>; 4],
+    ) -> Result<Buffer, GpuError> {
+        // VkDrawIndexedIndirectCommand: index count, instance count, first index, vertex offset, first instance.
+        let draws: Vec<[u32; 5]> = (0..patches as u32)
+            .flat_map(|k| {
+                quadrants
+                    .iter()
+                    .map(move |q| [q.end - q.start, 0, q.start, 0, k])
+            })
+            .collect();
+        let mut buffer = ctx.create_buffer(&BufferDesc {
+            name: "water draws",
+            size: (draws.len().max(1) * size_of::<vk::DrawIndexedIndirectCommand>()) as u64,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::INDIRECT_BUFFER,
+            location: MemoryLocation::CpuToGpu,
+        })?;
+        buffer.write(0, &draws)?;
+        Ok(buffer)
+    }
+
+    /// Records the pass that fills `cache` and `water_draws` for instances 0 .. `patches` (which `sets` bind), and
+    /// makes them visible to the vertex shaders and the indirect draws.
     pub(super) fn record(
         &self,
         rec: &mut Recorder,
         (sets, push): (&[vk::DescriptorSet], &[u8]),
-        cache: &Buffer,
+        (cache, water_draws): (&Buffer, &Buffer),
         patches: usize,
         n: u32,
     ) {
@@ -85,6 +116,13 @@ impl VertexCache {
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
             vk::PipelineStageFlags2::VERTEX_SHADER,
             vk::AccessFlags2::SHADER_STORAGE_READ,
+        );
+        rec.buffer_barrier(
+            water_draws,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::SHADER_STORAGE_READ,
+            vk::PipelineStageFlags2::DRAW_INDIRECT,
+            vk::AccessFlags2::INDIRECT_COMMAND_READ,
         );
     }
 
