@@ -14,11 +14,23 @@ use std::ops::Range;
 
 use crate::gpu::{vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation};
 
-/// The index buffer and the range of each quadrant in it (bit 0: +i half, bit 1: +j half). The whole buffer is
+/// The index ranges of one quadrant, laid out as grid cells, edge skirts, then the two midline skirts.
+#[derive(Clone, Debug, Default)]
+pub struct QuadrantMesh {
+    /// Its grid cells only: what the water pass's geometry shader turns into water (it drops skirts).
+    pub grid: Range<u32>,
+    /// Its grid cells and the skirts below the patch's edges: what the terrain pass always draws.
+    pub core: Range<u32>,
+    /// The skirt below the midline towards quadrant `q ^ 1` (the vertical midline) and towards `q ^ 2` (the
+    /// horizontal one): needed only where that quadrant is not drawn, i.e. covered by finer patches.
+    pub across: [Range<u32>; 2],
+}
+
+/// The index buffer and the ranges of each quadrant in it (bit 0: +i half, bit 1: +j half). The whole buffer is
 /// every triangle at least once (midline skirts twice).
 pub struct PatchMesh {
     pub indices: Vec<u32>,
-    pub quadrants: [Range<u32>; 4],
+    pub quadrants: [QuadrantMesh; 4],
 }
 
 /// Builds the mesh for `n x n` vertices (n = 2^k + 1).
@@ -27,7 +39,8 @@ pub fn patch_mesh(n: u32) -> PatchMesh {
     let skirt = |edge: u32, k: u32| n * n + edge * n + k;
     let m = (n - 1) / 2;
     let half = |k: u32| (k >= m) as u32;
-    let mut lists: [Vec<u32>; 4] = Default::default();
+    // Per quadrant: grid cells, edge skirts, the skirt towards q ^ 1, the skirt towards q ^ 2.
+    let mut lists: [[Vec<u32>; 4]; 4] = Default::default();
     for j in 0..n - 1 {
         for i in 0..n - 1 {
             let (a, b, c, d) = (
@@ -36,41 +49,50 @@ pub fn patch_mesh(n: u32) -> PatchMesh {
                 grid(i, j + 1),
                 grid(i + 1, j + 1),
             );
-            lists[(half(i) | half(j) << 1) as usize].extend_from_slice(&[a, b, d, a, d, c]);
+            lists[(half(i) | half(j) << 1) as usize][0].extend_from_slice(&[a, b, d, a, d, c]);
         }
     }
     for k in 0..n - 1 {
-        // (first vertex, second vertex, skirt edge, quadrants it belongs to)
+        // (first vertex, second vertex, skirt edge, list, quadrants it belongs to)
         let segments = [
-            (grid(k, 0), grid(k + 1, 0), 0, vec![half(k)]),
-            (grid(k, n - 1), grid(k + 1, n - 1), 1, vec![half(k) | 2]),
-            (grid(0, k), grid(0, k + 1), 2, vec![half(k) << 1]),
+            (grid(k, 0), grid(k + 1, 0), 0, 1, vec![half(k)]),
+            (grid(k, n - 1), grid(k + 1, n - 1), 1, 1, vec![half(k) | 2]),
+            (grid(0, k), grid(0, k + 1), 2, 1, vec![half(k) << 1]),
             (
                 grid(n - 1, k),
                 grid(n - 1, k + 1),
                 3,
+                1,
                 vec![1 | half(k) << 1],
             ),
             (
                 grid(m, k),
                 grid(m, k + 1),
                 4,
+                2,
                 vec![half(k) << 1, 1 | half(k) << 1],
             ),
-            (grid(k, m), grid(k + 1, m), 5, vec![half(k), half(k) | 2]),
+            (grid(k, m), grid(k + 1, m), 5, 3, vec![half(k), half(k) | 2]),
         ];
-        for (a, b, edge, quadrants) in segments {
+        for (a, b, edge, list, quadrants) in segments {
             let (sa, sb) = (skirt(edge, k), skirt(edge, k + 1));
             for q in quadrants {
-                lists[q as usize].extend_from_slice(&[a, b, sb, a, sb, sa]);
+                lists[q as usize][list].extend_from_slice(&[a, b, sb, a, sb, sa]);
             }
         }
     }
-    let mut indices = Vec::new();
-    let quadrants = lists.map(|list| {
-        let start = indices.len() as u32;
-        indices.extend(list);
-        start..indices.len() as u32
+    let mut indices: Vec<u32> = Vec::new();
+    let quadrants = lists.map(|parts| {
+        let ranges = parts.map(|part| {
+            let start = indices.len() as u32;
+            indices.extend(part);
+            start..indices.len() as u32
+        });
+        QuadrantMesh {
+            grid: ranges[0].clone(),
+            core: ranges[0].start..ranges[1].end,
+            across: [ranges[2].clone(), ranges[3].clone()],
+        }
     });
     PatchMesh { indices, quadrants }
 }
@@ -128,10 +150,30 @@ mod tests {
             mesh.indices.len() as u32,
             (n - 1) * (n - 1) * 6 + 4 * (n - 1) * 6 + 2 * 2 * (n - 1) * 6
         );
-        assert_eq!(mesh.quadrants[0].start, 0);
-        assert_eq!(mesh.quadrants[3].end, mesh.indices.len() as u32);
+        assert_eq!(mesh.quadrants[0].grid.start, 0);
+        assert_eq!(mesh.quadrants[3].across[1].end, mesh.indices.len() as u32);
+        let slice = |r: &Range<u32>| &mesh.indices[r.start as usize..r.end as usize];
+        for quadrant in &mesh.quadrants {
+            // The grid range holds the quadrant's 16 x 16 cells and nothing else; the core adds its two edges.
+            assert_eq!(quadrant.grid.len() as u32, (n - 1) * (n - 1) / 4 * 6);
+            assert!(slice(&quadrant.grid).iter().all(|&v| v < n * n));
+            assert_eq!(quadrant.core.start, quadrant.grid.start);
+            assert_eq!(
+                quadrant.core.len() - quadrant.grid.len(),
+                2 * (n as usize - 1) / 2 * 6
+            );
+            // A midline skirt hangs from the midline between q and its neighbour across it.
+            for (axis, across) in quadrant.across.iter().enumerate() {
+                let midline_edge = 4 + axis as u32;
+                assert_eq!(across.len() as u32, (n - 1) / 2 * 6);
+                assert!(slice(across)
+                    .iter()
+                    .all(|&v| v < n * n || (v - n * n) / n == midline_edge));
+            }
+        }
         // Every grid cell's triangles sit in the quadrant of the cell.
-        for (q, range) in mesh.quadrants.iter().enumerate() {
+        for (q, quadrant) in mesh.quadrants.iter().enumerate() {
+            let range = quadrant.core.start..quadrant.across[1].end;
             for tri in mesh.indices[range.start as usize..range.end as usize].chunks(3) {
                 if let Some(&v) = tri
                     .iter()

@@ -2,7 +2,7 @@
 //! in), with its morph towards its parent; the terrain drawn per quadrant, then the water through the geometry
 //! shader, then the sky where no surface is; optionally every terrain vertex captured as the vertex shader placed it.
 
-use std::collections::HashMap;
+use std::{collections::HashMap, ops::Range};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
@@ -240,15 +240,27 @@ impl Renderer<'_> {
         instances.extend(drawn.iter().map(|(i, _, _)| *i));
         let first_terrain_instance = instances.len();
         let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
-        let mut quadrant_instances: [std::ops::Range<u32>; 4] = Default::default();
-        for (q, range) in quadrant_instances.iter_mut().enumerate() {
-            let first = instances.len() as u32;
-            for (instance, _, patch) in drawn.iter().filter(|(i, _, _)| i.slots[2] & (1 << q) != 0)
-            {
-                instances.push(*instance);
-                instance_patches.push(*patch);
+        // The terrain's draws: each quadrant's cells and edge skirts for the instances that draw it, and its
+        // midline skirts only for those that leave the quadrant across the midline to finer patches.
+        let has = |i: &PatchInstance, q: usize| i.slots[2] & (1 << q) != 0;
+        let mut terrain_draws: Vec<(Range<u32>, Range<u32>)> = Vec::with_capacity(12);
+        for (q, mesh) in self.quadrants.iter().enumerate() {
+            let parts = [
+                (mesh.core.clone(), None),
+                (mesh.across[0].clone(), Some(q ^ 1)),
+                (mesh.across[1].clone(), Some(q ^ 2)),
+            ];
+            for (indices, across) in parts {
+                let first = instances.len() as u32;
+                for (instance, _, patch) in drawn
+                    .iter()
+                    .filter(|(i, _, _)| has(i, q) && across.is_none_or(|a| !has(i, a)))
+                {
+                    instances.push(*instance);
+                    instance_patches.push(*patch);
+                }
+                terrain_draws.push((indices, first..instances.len() as u32));
             }
-            *range = first..instances.len() as u32;
         }
         // Cached patches draw their water through the cache pass's indirect draws (instance k is patch k); the
         // rest as instances of their own.
@@ -295,7 +307,7 @@ impl Renderer<'_> {
             None
         };
         let vertex_cache = VertexCache::buffer(ctx, cached, n)?;
-        let water_draws = VertexCache::water_draws(ctx, cached, &self.quadrant_ranges)?;
+        let water_draws = VertexCache::water_draws(ctx, cached, &self.quadrants)?;
         let instance_set = rec.buffer_set(
             &self.instance_layout,
             &[
@@ -393,16 +405,9 @@ impl Renderer<'_> {
         } else {
             &self.terrain
         };
-        for (indices, instances) in self.quadrant_ranges.iter().zip(&quadrant_instances) {
+        for (indices, instances) in terrain_draws {
             stats.terrain_triangles += (indices.len() / 3 * instances.len()) as u64;
-            rec.draw_indexed(
-                terrain,
-                &sets,
-                push,
-                &self.indices,
-                indices.clone(),
-                instances.clone(),
-            );
+            rec.draw_indexed(terrain, &sets, push, &self.indices, indices, instances);
         }
         self.frames.profiler().end(rec, scope);
         let scope = self.frames.profiler().begin(rec, "water")?;
@@ -414,14 +419,16 @@ impl Renderer<'_> {
                 &water_draws,
                 4 * cached as u32,
             );
-            rec.draw_indexed(
-                &self.water,
-                &sets,
-                push,
-                &self.indices,
-                self.all_indices.clone(),
-                water_instances,
-            );
+            for mesh in &self.quadrants {
+                rec.draw_indexed(
+                    &self.water,
+                    &sets,
+                    push,
+                    &self.indices,
+                    mesh.grid.clone(),
+                    water_instances.clone(),
+                );
+            }
         }
         rec.free_after_completion(water_draws);
         self.frames.profiler().end(rec, scope);

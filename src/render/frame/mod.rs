@@ -19,7 +19,7 @@ use self::draw::FramePush;
 pub use self::draw::{DrawnVertex, PatchInstance, VertexCapture};
 pub use self::inflight::GpuTimes;
 use self::inflight::{InFlight, TIMESTAMP_SCOPES};
-use super::mesh::{index_buffer, patch_mesh, PatchMesh};
+use super::mesh::{index_buffer, patch_mesh, PatchMesh, QuadrantMesh};
 use crate::{
     config::{Config, LodRule},
     gpu::{
@@ -157,8 +157,7 @@ pub struct Renderer<'w> {
     no_capture: Buffer,
     vertex_cache: vertex_cache::VertexCache,
     indices: Buffer,
-    quadrant_ranges: [std::ops::Range<u32>; 4],
-    all_indices: std::ops::Range<u32>,
+    quadrants: [QuadrantMesh; 4],
     cache: PatchCache,
     frames: FrameRing<InFlight>,
     /// GPU times of finished frames not yet taken (`take_gpu_times`), the newest 1024 at most.
@@ -320,8 +319,7 @@ impl<'w> Renderer<'w> {
             no_capture,
             vertex_cache,
             indices,
-            quadrant_ranges: quadrants,
-            all_indices: 0..mesh.len() as u32,
+            quadrants,
             cache: PatchCache::new(capacity),
             frames,
             gpu_times: Default::default(),

@@ -10,7 +10,7 @@
 //! indirect draws, one per quadrant, that the pass gives an instance only where a vertex is in a river's basin or
 //! below sea level.
 
-use std::{mem::size_of, ops::Range};
+use std::mem::size_of;
 
 use super::FramePush;
 use crate::{
@@ -18,6 +18,7 @@ use crate::{
         pipeline::ComputePipeline, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
         Recorder,
     },
+    render::mesh::QuadrantMesh,
     shaders,
 };
 
@@ -67,18 +68,18 @@ impl VertexCache {
     }
 
     /// The water pass's indirect draws of `patches` cached patches: per patch (instance k) its four quadrants'
-    /// index ranges, with no instance until the cache's pass finds water there. At least one draw's bytes.
+    /// grid cells, with no instance until the cache's pass finds water there. At least one draw's bytes.
     pub(super) fn water_draws(
         ctx: &Context,
         patches: usize,
-        quadrants: &[Range<u32>; 4],
+        quadrants: &[QuadrantMesh; 4],
     ) -> Result<Buffer, GpuError> {
         // VkDrawIndexedIndirectCommand: index count, instance count, first index, vertex offset, first instance.
         let draws: Vec<[u32; 5]> = (0..patches as u32)
             .flat_map(|k| {
                 quadrants
                     .iter()
-                    .map(move |q| [q.end - q.start, 0, q.start, 0, k])
+                    .map(move |q| [q.grid.end - q.grid.start, 0, q.grid.start, 0, k])
             })
             .collect();
         let mut buffer = ctx.create_buffer(&BufferDesc {
