@@ -333,27 +333,25 @@ fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), Plo
         w,
         "## The frame on the default planet\n\nBeyond the thesis: the scripted approach on config/planet.xml at the \
          resolution given, in the default water mode, with each level-of-detail rule (`distance`, the thesis's \
-         Eq. 6.1, the default; `screen-space-error`), number of frames in flight, and the atmosphere on (the \
-         default) or off. Frame times are wall-clock per frame, waits for the GPU included.\n\n\
-         | report | level of detail | frames in flight | atmosphere | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) |\n\
-         |---|---|---|---|---|---|---|---|---|"
+         Eq. 6.1, the default; `screen-space-error`), number of frames in flight, the atmosphere on (the \
+         default) or off, and the vertex cache on (the default) or off (the thesis's vertex shaders). Frame times \
+         are wall-clock per frame, waits for the GPU included.\n\n\
+         | report | level of detail | frames in flight | atmosphere | vertex cache | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) | vertex cache pass ms (GPU) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|"
     );
     for path in paths {
         let d = read_report(path, "bench flight", "summary")?;
         let s = &d["summary"];
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} |",
+            "| {} | {} | {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} | {:.1} |",
             path.file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
             d["lod_rule"].as_str().unwrap_or("?"),
             d["frames_in_flight"],
-            // Reports from before the atmosphere had none.
-            if d["atmosphere"].as_bool().unwrap_or(false) {
-                "on"
-            } else {
-                "off"
-            },
+            // Reports from before the atmosphere or the vertex cache had none.
+            on_off(&d["atmosphere"]),
+            on_off(&d["vertex_cache"]),
             s["frames"],
             d["resolution"][0],
             d["resolution"][1],
@@ -361,10 +359,20 @@ fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), Plo
             f(&s["frame_ms_mean"]),
             f(&s["frame_ms_median"]),
             f(&s["average_gpu_ms"]["terrain"]),
+            f(&s["average_gpu_ms"]["vertices"]),
         );
     }
     let _ = writeln!(w);
     Ok(())
+}
+
+/// `on` for a JSON true, `off` for false or missing.
+fn on_off(v: &Value) -> &'static str {
+    if v.as_bool().unwrap_or(false) {
+        "on"
+    } else {
+        "off"
+    }
 }
 
 /// The comparison of `bench kernel --parent-reuse`: river data from the parent against from scratch.
