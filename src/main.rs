@@ -12,6 +12,7 @@ mod cli;
 
 use cli::{
     benchmarks::run_bench,
+    export::export,
     generate::generate,
     render::{render, view},
     Cli, Command,
@@ -75,6 +76,7 @@ fn main() -> ExitCode {
                 .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", out.display()))
         })()),
         Command::View(args) => finish(view(&options, &args)),
+        Command::Export { what } => finish(export(what)),
         Command::Bench { what } => finish(run_bench(&options, what)),
         Command::Config { file } => finish((|| {
             let config = Config::load(&file)?;

@@ -124,15 +124,30 @@ fn generate_with_the_thesis_model_writes_faces_layout_stats_rivers_and_preview()
     let features = rivers["features"].as_array().unwrap();
     assert!(!features.is_empty());
     for f in features {
-        assert_eq!(f["geometry"]["type"], "LineString");
-        for key in ["id", "width_start", "width_end", "lod"] {
-            assert!(!f["properties"][key].is_null());
+        // Cut at the antimeridian where a river crosses it (tests/export.rs checks the RFC's rules).
+        let lines = match f["geometry"]["type"].as_str().unwrap() {
+            "LineString" => vec![f["geometry"]["coordinates"].clone()],
+            "MultiLineString" => f["geometry"]["coordinates"].as_array().unwrap().clone(),
+            other => panic!("a river as {other}"),
+        };
+        for key in ["id", "order", "width_start", "width_end", "length", "level"] {
+            assert!(!f["properties"][key].is_null(), "no {key}");
         }
-        for c in f["geometry"]["coordinates"].as_array().unwrap() {
+        for c in lines.iter().flat_map(|l| l.as_array().unwrap()) {
             let (lon, lat) = (c[0].as_f64().unwrap(), c[1].as_f64().unwrap());
             assert!((-180.0..=180.0).contains(&lon) && (-90.0..=90.0).contains(&lat));
         }
     }
+    // The GeoJSON holds the tributaries stats.json counts.
+    let tributaries = features
+        .iter()
+        .filter(|f| !f["properties"]["parent"].is_null())
+        .count();
+    assert_eq!(tributaries as u64, stats["tributaries"].as_u64().unwrap());
+    assert_eq!(
+        (features.len() - tributaries) as u64,
+        stats["rivers"].as_u64().unwrap()
+    );
     assert!(out.join("preview.png").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -249,7 +264,7 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
     let features = geojson["features"].as_array().unwrap();
     let reaches: Vec<&serde_json::Value> = features
         .iter()
-        .filter(|f| f["geometry"]["type"] == "LineString")
+        .filter(|f| f["properties"]["strahler"].is_u64())
         .collect();
     let lakes = features.len() - reaches.len();
     assert_eq!(lakes as u64, stats["lakes"].as_u64().unwrap());
@@ -260,9 +275,7 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
         assert!(p["strahler"].as_u64().unwrap() >= 1 && p["width"].as_f64().unwrap() > 0.0);
         assert!(p["drainage_area"].as_f64().unwrap() > 0.0);
         // Coordinates run downstream: the bed (third coordinate) never rises.
-        let beds: Vec<f64> = reach["geometry"]["coordinates"]
-            .as_array()
-            .unwrap()
+        let beds: Vec<f64> = positions(&reach["geometry"])
             .iter()
             .map(|c| c[2].as_f64().unwrap())
             .collect();
@@ -271,12 +284,15 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
             let next = reaches[down as usize];
             assert_eq!(next["properties"]["id"].as_u64(), Some(down));
             // It flows into the reach that starts where it ends.
-            let last = reach["geometry"]["coordinates"]
-                .as_array()
-                .unwrap()
-                .last()
-                .unwrap();
-            assert_eq!(&next["geometry"]["coordinates"][0], last);
+            let last = positions(&reach["geometry"]).last().unwrap().clone();
+            let first = positions(&next["geometry"])[0].clone();
+            // The same point; on the antimeridian -180 and 180 both name it.
+            let lon = |p: &serde_json::Value| p[0].as_f64().unwrap().rem_euclid(360.0);
+            assert_eq!(
+                (first[1].clone(), first[2].clone()),
+                (last[1].clone(), last[2].clone())
+            );
+            assert_eq!(lon(&first), lon(&last), "{first} against {last}");
         }
     }
     let preview = image::open(dir.join("preview.png")).unwrap().to_rgb8();
@@ -286,6 +302,20 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
         .filter(|p| p.0 == [20, 60, 180] || p.0 == [30, 100, 220])
         .count();
     assert!(dark > 50, "{dark} pixels of order 4 or 5 rivers");
+}
+
+/// The positions of a LineString, or of a MultiLineString's lines one after the other (a line cut at the
+/// antimeridian).
+fn positions(geometry: &serde_json::Value) -> Vec<serde_json::Value> {
+    let coordinates = geometry["coordinates"].as_array().unwrap();
+    match geometry["type"].as_str().unwrap() {
+        "LineString" => coordinates.clone(),
+        "MultiLineString" => coordinates
+            .iter()
+            .flat_map(|l| l.as_array().unwrap().clone())
+            .collect(),
+        other => panic!("a reach as {other}"),
+    }
 }
 
 #[test]

@@ -49,8 +49,9 @@ pub fn generate(
     let t = std::time::Instant::now();
     let network = riverplanet::river::network::RiverNetwork::generate(&planet, &config, seed);
     let river_ms = t.elapsed().as_secs_f64() * 1e3;
-    let geojson_depth = 2;
-    let (rivers, tributaries) = network.count(config.river.hull_levels);
+    // The GeoJSON holds the branches stats.json counts.
+    let geojson_depth = config.river.hull_levels;
+    let (rivers, tributaries) = network.count(geojson_depth);
     let t = std::time::Instant::now();
     if let Some(bar) = &bar {
         bar.set_message("writing");
@@ -80,7 +81,7 @@ pub fn generate(
     let path = out.join("rivers.geojson");
     let geojson = match &planet.drainage {
         Some(drainage) => riverplanet::export::drainage::drainage_geojson(drainage, &config),
-        None => riverplanet::export::rivers_geojson(&network, geojson_depth),
+        None => riverplanet::export::rivers_geojson(&network, geojson_depth, planet.radius),
     };
     riverplanet::export::files::write_bytes(&path, serde_json::to_string(&geojson)?.as_bytes())?;
     let mut stats = planet.stats.clone();

@@ -2,6 +2,7 @@
 //! module per group of commands.
 
 pub mod benchmarks;
+pub mod export;
 pub mod generate;
 pub mod render;
 
@@ -55,6 +56,11 @@ pub enum Command {
         /// on-demand refinement as the renderer's patches. Default: 6, or max-level-of-detail if lower.
         #[arg(long)]
         level: Option<u32>,
+    },
+    /// Export the planet for other tools (beyond the thesis).
+    Export {
+        #[command(subcommand)]
+        what: ExportCommand,
     },
     /// Render one image headless (no display, no window system) and print per-pass GPU times.
     Render(RenderArgs),
@@ -213,6 +219,25 @@ pub struct PlanetArgs {
     /// Override master-seed.
     #[arg(long)]
     pub seed: Option<u32>,
+}
+
+/// What `riverplanet export` writes.
+#[derive(Subcommand)]
+pub enum ExportCommand {
+    /// The rivers as RFC 7946 GeoJSON: lines cut at the antimeridian, [lon, lat] (the drainage model: [lon, lat,
+    /// bed height]) rounded to 1e-6 degrees, with width, length and order (Strahler order for the drainage
+    /// model); the drainage model's lakes as polygons.
+    Rivers {
+        #[command(flatten)]
+        planet: PlanetArgs,
+        /// The thesis's river model only: how often its pieces are refined, 0 to 8 [default: hull-levels, what
+        /// `generate` counts in stats.json]. The drainage model's reaches have one level.
+        #[arg(long)]
+        level: Option<u32>,
+        /// The GeoJSON file (.geojson or .json).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 /// The planet a benchmark runs on (seed 1 unless given, so runs compare).

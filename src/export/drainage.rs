@@ -5,60 +5,59 @@ use glam::{DVec2, DVec3};
 use image::{Rgb, RgbImage};
 use serde_json::json;
 
-use super::cross_pixel;
+use super::{cross_pixel, geojson};
 use crate::{
     config::Config,
     drainage::Drainage,
-    planet::lon_lat,
     river::{drainage::reach_width, hull},
 };
 
-/// Every reach as a LineString of [lon, lat, bed height] in flow order, with `id`, `downstream` (the id it flows
-/// into, or null at a mouth), `strahler`, `drainage_area` (at its lower end, world units squared) and `width`
-/// (full width there); every lake as a Polygon (the convex outline of its lattice points) with its `level`.
+/// Every reach as a LineString of [lon, lat, bed height] in flow order (RFC 7946, module `geojson`: cut at the
+/// antimeridian, rounded), with `id`, `downstream` (the id it flows into, or null at a mouth), `strahler`,
+/// `drainage_area` (at its lower end, world units squared), `width` (full width there) and `length` (world units
+/// along the sphere of the planet's radius); every lake as a Polygon (the convex outline of its lattice points)
+/// with its `level` and `area`.
 pub fn drainage_geojson(drainage: &Drainage, config: &Config) -> serde_json::Value {
+    let radius = config.planet.radius as f64;
     let mut features: Vec<serde_json::Value> = drainage
         .reaches
         .iter()
         .enumerate()
         .map(|(id, reach)| {
-            let coordinates: Vec<[f64; 3]> = reach
+            let points: Vec<(DVec3, Option<f64>)> = reach
                 .points
                 .iter()
                 .zip(&reach.beds)
-                .map(|(p, bed)| {
-                    let (lon, lat) = lon_lat(*p);
-                    [lon, lat, *bed as f64]
-                })
+                .map(|(p, bed)| (*p, Some(*bed as f64)))
                 .collect();
             let area = reach.areas.last().copied().unwrap_or(0.0);
             json!({
                 "type": "Feature",
-                "geometry": { "type": "LineString", "coordinates": coordinates },
+                "geometry": geojson::line_geometry(&points),
                 "properties": {
                     "id": id,
                     "downstream": reach.downstream,
                     "strahler": reach.strahler,
                     "drainage_area": area,
                     "width": reach_width(config, drainage, area),
+                    "length": geojson::length(&reach.points, radius),
                 },
             })
         })
         .collect();
     for (id, lake) in drainage.lakes.iter().enumerate() {
-        let ring = outline(&lake.points);
         features.push(json!({
             "type": "Feature",
-            "geometry": { "type": "Polygon", "coordinates": [ring] },
+            "geometry": geojson::polygon_geometry(&outline(&lake.points)),
             "properties": { "lake": id, "level": lake.level, "area": lake.area },
         }));
     }
     json!({ "type": "FeatureCollection", "features": features })
 }
 
-/// The convex outline of `points` as a closed [lon, lat] ring (counter-clockwise), made in the tangent plane at
-/// their centre.
-fn outline(points: &[DVec3]) -> Vec<[f64; 2]> {
+/// The convex outline of `points` as a closed ring of unit directions (counter-clockwise), made in the tangent
+/// plane at their centre.
+fn outline(points: &[DVec3]) -> Vec<DVec3> {
     let centre = points.iter().copied().sum::<DVec3>().normalize();
     let e1 = centre.any_orthonormal_vector();
     let e2 = centre.cross(e1);
@@ -69,12 +68,9 @@ fn outline(points: &[DVec3]) -> Vec<[f64; 2]> {
             DVec2::new(q.dot(e1), q.dot(e2))
         })
         .collect();
-    let mut ring: Vec<[f64; 2]> = hull::convex_hull(&plane)
+    let mut ring: Vec<DVec3> = hull::convex_hull(&plane)
         .iter()
-        .map(|q| {
-            let (lon, lat) = lon_lat((centre + e1 * q.x + e2 * q.y).normalize());
-            [lon, lat]
-        })
+        .map(|q| (centre + e1 * q.x + e2 * q.y).normalize())
         .collect();
     if let Some(first) = ring.first().copied() {
         ring.push(first);

@@ -9,6 +9,7 @@ use serde_json::json;
 
 pub mod drainage;
 pub mod files;
+pub mod geojson;
 
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},
@@ -189,10 +190,15 @@ pub fn equirectangular_land(planet: &Planet, width: u32) -> image::GrayImage {
     })
 }
 
-/// GeoJSON LineStrings of every river and tributary at `depth` (longitude/latitude in degrees).
+/// Every river and tributary of the thesis's network at `depth` (Section 5.3's pieces refined `depth` times), as
+/// RFC 7946 GeoJSON (module `geojson`: cut at the antimeridian, rounded): one feature per branch with `id`,
+/// `parent` (the id it flows into, null for a main river), `order` (0 for a main river, its parent's plus one for a
+/// tributary), `width_start` and `width_end` (full widths, world units), `length` (world units along the sphere
+/// of `radius`) and `level` (`depth`). As many tributaries as `RiverNetwork::count(depth)` counts.
 pub fn rivers_geojson(
     network: &crate::river::network::RiverNetwork,
     depth: u32,
+    radius: f64,
 ) -> serde_json::Value {
     let mut features = Vec::new();
     for system in &network.systems {
@@ -204,24 +210,29 @@ pub fn rivers_geojson(
                 format!("{}-{:08x}", system.id, branch as u32)
             }
         };
+        let order = |line: &crate::river::samples::Branch| {
+            let mut order = 0;
+            let mut parent = line.parent;
+            while let Some(key) = parent {
+                order += 1;
+                parent = lines.iter().find(|l| l.key == key).and_then(|l| l.parent);
+            }
+            order
+        };
         for line in &lines {
-            let coordinates: Vec<[f64; 2]> = line
-                .points
-                .iter()
-                .map(|p| {
-                    let (lon, lat) = crate::planet::lon_lat(*p);
-                    [lon, lat]
-                })
-                .collect();
+            let points: Vec<(glam::DVec3, Option<f64>)> =
+                line.points.iter().map(|p| (*p, None)).collect();
             features.push(json!({
                 "type": "Feature",
-                "geometry": { "type": "LineString", "coordinates": coordinates },
+                "geometry": geojson::line_geometry(&points),
                 "properties": {
                     "id": name(line.key),
                     "parent": line.parent.map(name),
+                    "order": order(line),
                     "width_start": line.widths.0,
                     "width_end": line.widths.1,
-                    "lod": depth,
+                    "length": geojson::length(&line.points, radius),
+                    "level": depth,
                 },
             }));
         }

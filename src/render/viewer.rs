@@ -335,12 +335,14 @@ impl App<'_> {
         let renderer = self.renderer.as_ref();
         let gpu = |name: &str| stats.gpu_ms.get(name).copied().unwrap_or(0.0);
         window.set_title(&format!(
-            "riverplanet | seed {} | {:.1} ms ({:.0} fps) | gpu kernel {:.2} terrain {:.1} water {:.1} sky {:.1} ms | {} \
+            "riverplanet | seed {} | {:.1} ms ({:.0} fps) | gpu kernel {:.2} vertices {:.1} terrain {:.1} water {:.1} sky \
+             {:.1} ms | {} \
              patches ({} new) | altitude {:.1} | water {:?}{}{}{}",
             self.world.seed,
             self.smoothed_ms,
             1000.0 / self.smoothed_ms.max(1e-3),
             gpu("kernel"),
+            gpu("vertices"),
             gpu("terrain"),
             gpu("water"),
             gpu("sky"),
