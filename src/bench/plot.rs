@@ -42,60 +42,119 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-/// A line chart over frames, written to `base.svg` and `base.png`.
+/// The frames before this are the flight's start (patches of every level arriving at once): their spikes are left
+/// off a chart's scale when they would flatten the rest, and the title says how high they reach.
+const START_FRAMES: f64 = crate::bench::flight::WARMUP_FRAMES as f64;
+
+/// The runs of consecutive frames of `points`: a line is drawn along each, none across frames without data; a run
+/// of one frame is a short tick.
+fn runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    for &p in points {
+        match runs.last_mut() {
+            Some(run) if run.last().is_some_and(|q| p.0 - q.0 <= 1.0) => run.push(p),
+            _ => runs.push(vec![p]),
+        }
+    }
+    for run in &mut runs {
+        if let [(x, y)] = run[..] {
+            *run = vec![(x - 0.4, y), (x + 0.4, y)];
+        }
+    }
+    runs
+}
+
+/// A line chart over the `frames` frames of a flight, written to `base.svg` and `base.png`: integer frames, no
+/// line across frames without data, the start's spikes off the scale where they would flatten the rest, and the
+/// camera's `altitude` per frame on a second axis (grey).
 pub fn line_chart(
     base: &Path,
     title: &str,
     y_label: &str,
     series: &[Series],
+    (frames, altitude): (usize, &[f64]),
 ) -> Result<(), PlotError> {
     register_font()?;
     let draw_err = |e: &dyn std::fmt::Display| PlotError::Draw {
         path: base.display().to_string(),
         message: e.to_string(),
     };
-    let x_max = series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.0))
-        .fold(1.0, f64::max);
-    let y_max = series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.1))
-        .fold(0.0, f64::max)
-        .max(1e-6)
-        * 1.08;
+    let x_max = (frames.max(2) - 1) as f64;
+    let highest = |after: f64| {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(move |p| p.0 >= after).map(|p| p.1))
+            .fold(0.0, f64::max)
+    };
+    let (all, later) = (highest(0.0), highest(START_FRAMES));
+    let (y_max, title) = if later > 0.0 && all > 1.5 * later {
+        (
+            later * 1.12,
+            format!(
+                "{title} (frames 0-{} reach {all:.1}, off the scale)",
+                START_FRAMES - 1.0
+            ),
+        )
+    } else {
+        (all.max(1e-6) * 1.08, title.to_string())
+    };
+    let altitude_max = altitude.iter().copied().fold(1e-6, f64::max) * 1.05;
     let colours = [
         RGBColor(31, 119, 180),
         RGBColor(255, 127, 14),
         RGBColor(44, 160, 44),
         RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
     ];
+    let grey = RGBColor(150, 150, 150);
     let (w, h) = (960u32, 540u32);
     macro_rules! draw {
         ($backend:expr) => {{
             let root = $backend.into_drawing_area();
             root.fill(&WHITE).map_err(|e| draw_err(&e))?;
             let mut chart = ChartBuilder::on(&root)
-                .caption(title, ("sans-serif", 22))
+                .caption(&title, ("sans-serif", 22))
                 .margin(16)
                 .x_label_area_size(40)
                 .y_label_area_size(70)
+                .right_y_label_area_size(70)
                 .build_cartesian_2d(0.0..x_max, 0.0..y_max)
-                .map_err(|e| draw_err(&e))?;
+                .map_err(|e| draw_err(&e))?
+                .set_secondary_coord(0.0..x_max, 0.0..altitude_max);
             chart
                 .configure_mesh()
                 .x_desc("frame")
                 .y_desc(y_label)
+                .x_label_formatter(&|x| format!("{x:.0}"))
                 .label_style(("sans-serif", 14))
                 .draw()
                 .map_err(|e| draw_err(&e))?;
+            chart
+                .configure_secondary_axes()
+                .y_desc("altitude (world units)")
+                .y_label_formatter(&|a| format!("{a:.0}"))
+                .label_style(("sans-serif", 14))
+                .draw()
+                .map_err(|e| draw_err(&e))?;
+            chart
+                .draw_secondary_series(LineSeries::new(
+                    altitude.iter().enumerate().map(|(k, a)| (k as f64, *a)),
+                    grey.stroke_width(1),
+                ))
+                .map_err(|e| draw_err(&e))?
+                .label("altitude (right axis)")
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], grey.stroke_width(1))
+                });
             for (k, s) in series.iter().enumerate() {
                 let colour = colours[k % colours.len()];
                 chart
-                    .draw_series(LineSeries::new(
-                        s.points.iter().copied(),
-                        colour.stroke_width(2),
-                    ))
+                    .draw_series(
+                        runs(&s.points)
+                            .into_iter()
+                            .map(|run| PathElement::new(run, colour.stroke_width(2))),
+                    )
                     .map_err(|e| draw_err(&e))?
                     .label(s.name.clone())
                     .legend(move |(x, y)| {
@@ -179,9 +238,13 @@ pub fn flight_figures(
     };
     let label = if stress { " (stress test)" } else { "" };
     let mut written = Vec::new();
+    let altitude: Vec<f64> = frames
+        .iter()
+        .map(|f| f["altitude"].as_f64().unwrap_or(f64::NAN))
+        .collect();
     let mut chart =
         |name: String, title: String, y: &str, s: Vec<Series>| -> Result<(), PlotError> {
-            line_chart(&out.join(&name), &title, y, &s)?;
+            line_chart(&out.join(&name), &title, y, &s, (frames.len(), &altitude))?;
             written.push(name);
             Ok(())
         };
@@ -273,9 +336,26 @@ pub fn flight_figures(
         "ms",
         vec![
             series(&frames, "kernel", g("kernel")),
+            series(&frames, "vertex cache", g("vertices")),
             series(&frames, "terrain", g("terrain")),
             series(&frames, "water", g("water")),
+            series(&frames, "sky", g("sky")),
         ],
     )?;
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::runs;
+
+    #[test]
+    fn lines_run_along_consecutive_frames_only_and_a_lone_frame_is_a_tick() {
+        let points = [(0.0, 1.0), (1.0, 2.0), (5.0, 3.0), (7.0, 4.0), (8.0, 5.0)];
+        let r = runs(&points);
+        assert_eq!(r.len(), 3);
+        assert_eq!(r[0], vec![(0.0, 1.0), (1.0, 2.0)]);
+        assert_eq!(r[1], vec![(4.6, 3.0), (5.4, 3.0)]);
+        assert_eq!(r[2], vec![(7.0, 4.0), (8.0, 5.0)]);
+    }
 }
