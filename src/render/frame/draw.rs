@@ -4,46 +4,20 @@
 
 use std::{collections::HashMap, ops::Range};
 
-use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 
 use super::{
-    vertex_cache::VertexCache, FrameStats, Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT,
+    shader_data::{instance, PatchInstance, NO_MORPH},
+    vertex_cache::VertexCache,
+    FrameStats, Renderer,
 };
 use crate::{
     gpu::{
         pipeline::RenderTarget, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
     },
-    planet::cube::{cube_point, PatchId, EDGES, FACE_AXES},
-    river::samples::PatchFrame,
-    runtime::{cache::PatchData, camera::Camera, lod::Selected},
+    planet::cube::{PatchId, EDGES},
+    runtime::{camera::Camera, lod::Selected},
 };
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(super) struct FramePush {
-    view_projection: [[f32; 4]; 4],
-    sun: [f32; 4],
-    planet: [f32; 4],
-    extra: [f32; 4],
-    camera: [f32; 4],
-}
-
-/// std430 mirror of `PatchInstance` in glsl/terrain_common.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct PatchInstance {
-    centre_rel: [f32; 4],
-    centre_dir: [f32; 4],
-    cube_centre: [f32; 4],
-    axis_u: [f32; 4],
-    axis_v: [f32; 4],
-    tex_rect: [f32; 4],
-    slots: [i32; 4],
-    morph: [f32; 4],
-    /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
-    detail: [f32; 4],
-}
 
 /// Every drawn terrain vertex of one frame, as the vertex shader placed it.
 #[derive(Clone, Debug)]
@@ -122,10 +96,6 @@ impl Drawn {
                 .collect(),
         })
     }
-}
-
-fn to_f32(m: DMat4) -> [[f32; 4]; 4] {
-    m.as_mat4().to_cols_array_2d()
 }
 
 impl Renderer<'_> {
@@ -320,46 +290,8 @@ impl Renderer<'_> {
         rec.free_after_completion(instance_buffer);
 
         // Section 8: terrain, then water.
-        let sun = self.sun.unwrap_or_else(|| {
-            (camera.position.normalize() * 0.8
-                + camera.up.cross(camera.forward).normalize() * 0.5
-                + camera.up * 0.3)
-                .normalize()
-        });
-        let sky = self.sky();
-        let draw_sky = sky.is_some();
-        let view_mode = match self.view_mode {
-            ViewMode::Shaded => 0,
-            ViewMode::Lod => 1,
-            ViewMode::PaintedRed => 2,
-        };
-        let push = FramePush {
-            view_projection: to_f32(camera.projection() * camera.rotation()),
-            sun: [
-                sun.x as f32,
-                sun.y as f32,
-                sun.z as f32,
-                self.planet.sea_level,
-            ],
-            planet: [
-                radius as f32,
-                n as f32,
-                (self.water_mode as u32 + 4 * view_mode + 16 * !self.flowing_water as u32) as f32,
-                self.heights.min as f32,
-            ],
-            extra: [
-                sky.map_or(-1.0, |s| s.slot()),
-                self.time,
-                self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
-                self.capture_vertices as u32 as f32,
-            ],
-            camera: [
-                camera.position.x as f32,
-                camera.position.y as f32,
-                camera.position.z as f32,
-                sky.map_or(0.0, |s| s.height),
-            ],
-        };
+        let draw_sky = self.sky().is_some();
+        let push = self.frame_push(camera);
         let sets = [self.bindless.set, instance_set];
         let push = bytemuck::bytes_of(&push);
         let scope = self.frames.profiler().begin(rec, "vertices")?;
@@ -467,64 +399,6 @@ fn mesh_vertices(n: u32) -> u32 {
     n * n + 6 * n
 }
 
-/// The instance that draws `selected` from `source`'s textures (itself, or an ancestor standing in).
-fn instance(
-    selected: &Selected,
-    source: PatchId,
-    data: &PatchData,
-    camera: DVec3,
-    radius: f64,
-    n: u32,
-) -> PatchInstance {
-    let p = selected.patch;
-    let centre = p.center();
-    let rel = centre * radius - camera;
-    // The patch's frame on the cube, in f64: its centre and the steps across it (docs/rendering.md, "Precision").
-    let (_, a, b) = FACE_AXES[p.face as usize];
-    let (uc, vc) = p.uv(0.5, 0.5);
-    let cube_centre = cube_point(p.face as usize, uc, vc);
-    let (axis_u, axis_v) = (a * p.size(), b * p.size());
-    let with = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
-    let depth = (p.level - source.level) as u32;
-    let scale = 1.0 / (1u32 << depth) as f32;
-    let offset_x = (p.x - (source.x << depth)) as f32 * scale * (n - 1) as f32;
-    let offset_y = (p.y - (source.y << depth)) as f32 * scale * (n - 1) as f32;
-    let spacing = PatchFrame::new(p, radius, n).spacing();
-    PatchInstance {
-        centre_rel: [rel.x as f32, rel.y as f32, rel.z as f32, p.level as f32],
-        centre_dir: [
-            centre.x as f32,
-            centre.y as f32,
-            centre.z as f32,
-            spacing as f32,
-        ],
-        cube_centre: with(cube_centre, cube_centre.length()),
-        axis_u: with(axis_u, 2.0 * cube_centre.dot(axis_u)),
-        axis_v: with(axis_v, 2.0 * cube_centre.dot(axis_v)),
-        tex_rect: [offset_x, offset_y, scale, 0.0],
-        slots: [
-            data.base_slot.0 as i32,
-            data.river.as_ref().map_or(-1, |(_, s)| s.0 as i32),
-            selected.quadrants as i32,
-            -1,
-        ],
-        morph: NO_MORPH,
-        detail: [
-            (centre.x * radius).rem_euclid(DETAIL_PERIOD) as f32,
-            (centre.y * radius).rem_euclid(DETAIL_PERIOD) as f32,
-            (centre.z * radius).rem_euclid(DETAIL_PERIOD) as f32,
-            0.0,
-        ],
-    }
-}
-
-/// The period in world units of the fragment shader's ground detail: patch centres are reduced modulo it in f64, so
-/// the detail's coordinates stay small (precise to 0.02 mm) at any planet size, and the finest octave's lattice
-/// (4096 cells) stays within what the shader's cheap float hash resolves; every octave's lattice divides it, so
-/// neighbouring patches agree although their centres wrap differently. The detail repeats every 256 units (metres
-/// on config/earth.xml), under terrain that does not.
-const DETAIL_PERIOD: f64 = 256.0;
-
 /// Skirt length beside patches with their own data, in vertex spacings (docs/rendering.md, "No holes").
 const SKIRT_SPACINGS: f32 = 2.0;
 
@@ -559,9 +433,6 @@ struct StandIns {
     drawn: HashMap<PatchId, f32>,
     below: HashMap<PatchId, f32>,
 }
-
-/// Morph distances that never morph (the level-0 patches, and the thesis's instant switching).
-const NO_MORPH: [f32; 4] = [f32::MAX, 1.0, 0.0, 0.0];
 
 /// Share of a level's switch distance over which its patches morph into their parent's shape (CDLOD's morph
 /// region): from 70 % of the distance on, fully at it.

@@ -6,6 +6,7 @@
 mod draw;
 mod inflight;
 mod plan;
+mod shader_data;
 mod sky;
 mod upload;
 mod vertex_cache;
@@ -15,10 +16,11 @@ use std::{collections::BTreeMap, time::Instant};
 use glam::DVec3;
 use serde::Serialize;
 
-use self::draw::FramePush;
-pub use self::draw::{DrawnVertex, PatchInstance, VertexCapture};
+pub use self::draw::{DrawnVertex, VertexCapture};
 pub use self::inflight::GpuTimes;
 use self::inflight::{InFlight, TIMESTAMP_SCOPES};
+use self::shader_data::FramePush;
+pub use self::shader_data::PatchInstance;
 use super::mesh::{index_buffer, patch_mesh, PatchMesh, QuadrantMesh};
 use crate::{
     config::{Config, LodRule},

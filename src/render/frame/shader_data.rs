@@ -1,0 +1,156 @@
+//! What crosses to the shaders each frame (std430 and push-constant mirrors of glsl/terrain_common.glsl, their
+//! sizes checked at compile time): the push constants every pass reads, and the instance of one drawn patch.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3};
+
+use super::{Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT};
+use crate::{
+    planet::cube::{cube_point, PatchId, FACE_AXES},
+    river::samples::PatchFrame,
+    runtime::{cache::PatchData, camera::Camera, lod::Selected},
+};
+
+/// The push constants of every pass (`FramePush` in glsl/terrain_common.glsl); 128 bytes, what every Vulkan
+/// device holds.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub(super) struct FramePush {
+    view_projection: [[f32; 4]; 4],
+    sun: [f32; 4],
+    planet: [f32; 4],
+    extra: [f32; 4],
+    camera: [f32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<FramePush>() == 128);
+
+/// std430 mirror of `PatchInstance` in glsl/terrain_common.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PatchInstance {
+    pub(super) centre_rel: [f32; 4],
+    pub(super) centre_dir: [f32; 4],
+    pub(super) cube_centre: [f32; 4],
+    pub(super) axis_u: [f32; 4],
+    pub(super) axis_v: [f32; 4],
+    pub(super) tex_rect: [f32; 4],
+    pub(super) slots: [i32; 4],
+    pub(super) morph: [f32; 4],
+    /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
+    pub(super) detail: [f32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<PatchInstance>() == 9 * 16);
+
+impl Renderer<'_> {
+    /// This frame's push constants for `camera`.
+    pub(super) fn frame_push(&self, camera: &Camera) -> FramePush {
+        let radius = self.planet.radius;
+        let n = self.config.rendering.vertices;
+        let sun = self.sun.unwrap_or_else(|| {
+            (camera.position.normalize() * 0.8
+                + camera.up.cross(camera.forward).normalize() * 0.5
+                + camera.up * 0.3)
+                .normalize()
+        });
+        let sky = self.sky();
+        let view_mode = match self.view_mode {
+            ViewMode::Shaded => 0,
+            ViewMode::Lod => 1,
+            ViewMode::PaintedRed => 2,
+        };
+        FramePush {
+            view_projection: to_f32(camera.projection() * camera.rotation()),
+            sun: [
+                sun.x as f32,
+                sun.y as f32,
+                sun.z as f32,
+                self.planet.sea_level,
+            ],
+            planet: [
+                radius as f32,
+                n as f32,
+                (self.water_mode as u32 + 4 * view_mode + 16 * !self.flowing_water as u32) as f32,
+                self.heights.min as f32,
+            ],
+            extra: [
+                sky.map_or(-1.0, |s| s.slot()),
+                self.time,
+                self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
+                self.capture_vertices as u32 as f32,
+            ],
+            camera: [
+                camera.position.x as f32,
+                camera.position.y as f32,
+                camera.position.z as f32,
+                sky.map_or(0.0, |s| s.height),
+            ],
+        }
+    }
+}
+
+fn to_f32(m: DMat4) -> [[f32; 4]; 4] {
+    m.as_mat4().to_cols_array_2d()
+}
+
+/// The instance that draws `selected` from `source`'s textures (itself, or an ancestor standing in).
+pub(super) fn instance(
+    selected: &Selected,
+    source: PatchId,
+    data: &PatchData,
+    camera: DVec3,
+    radius: f64,
+    n: u32,
+) -> PatchInstance {
+    let p = selected.patch;
+    let centre = p.center();
+    let rel = centre * radius - camera;
+    // The patch's frame on the cube, in f64: its centre and the steps across it (docs/rendering.md, "Precision").
+    let (_, a, b) = FACE_AXES[p.face as usize];
+    let (uc, vc) = p.uv(0.5, 0.5);
+    let cube_centre = cube_point(p.face as usize, uc, vc);
+    let (axis_u, axis_v) = (a * p.size(), b * p.size());
+    let with = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+    let depth = (p.level - source.level) as u32;
+    let scale = 1.0 / (1u32 << depth) as f32;
+    let offset_x = (p.x - (source.x << depth)) as f32 * scale * (n - 1) as f32;
+    let offset_y = (p.y - (source.y << depth)) as f32 * scale * (n - 1) as f32;
+    let spacing = PatchFrame::new(p, radius, n).spacing();
+    PatchInstance {
+        centre_rel: [rel.x as f32, rel.y as f32, rel.z as f32, p.level as f32],
+        centre_dir: [
+            centre.x as f32,
+            centre.y as f32,
+            centre.z as f32,
+            spacing as f32,
+        ],
+        cube_centre: with(cube_centre, cube_centre.length()),
+        axis_u: with(axis_u, 2.0 * cube_centre.dot(axis_u)),
+        axis_v: with(axis_v, 2.0 * cube_centre.dot(axis_v)),
+        tex_rect: [offset_x, offset_y, scale, 0.0],
+        slots: [
+            data.base_slot.0 as i32,
+            data.river.as_ref().map_or(-1, |(_, s)| s.0 as i32),
+            selected.quadrants as i32,
+            -1,
+        ],
+        morph: NO_MORPH,
+        detail: [
+            (centre.x * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            (centre.y * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            (centre.z * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            0.0,
+        ],
+    }
+}
+
+/// The period in world units of the fragment shader's ground detail: patch centres are reduced modulo it in f64, so
+/// the detail's coordinates stay small (precise to 0.02 mm) at any planet size, and the finest octave's lattice
+/// (4096 cells) stays within what the shader's cheap float hash resolves; every octave's lattice divides it, so
+/// neighbouring patches agree although their centres wrap differently. The detail repeats every 256 units (metres
+/// on config/earth.xml), under terrain that does not.
+const DETAIL_PERIOD: f64 = 256.0;
+
+/// Morph distances that never morph (the level-0 patches, and the thesis's instant switching).
+pub(super) const NO_MORPH: [f32; 4] = [f32::MAX, 1.0, 0.0, 0.0];
