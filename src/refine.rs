@@ -33,12 +33,16 @@ struct GpuRefineJob {
     unused: i32,
 }
 
+const _: () = assert!(std::mem::size_of::<GpuRefineJob>() == 32);
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct RefinePush {
     seed: u32,
     amplitude: f32,
 }
+
+const _: () = assert!(std::mem::size_of::<RefinePush>() == 8);
 
 /// A patch to refine: its id, the slot its fresh texture is bound at, and its parent's slot.
 #[derive(Clone, Copy, Debug)]

@@ -25,6 +25,8 @@ pub struct RiverSample {
     pub _pad: [f32; 2],
 }
 
+const _: () = assert!(std::mem::size_of::<RiverSample>() == 32);
+
 impl RiverSample {
     pub fn new(position: [f32; 2], derivative: [f32; 2], height: f32, width: f32) -> Self {
         Self {

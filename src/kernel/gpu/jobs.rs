@@ -24,6 +24,8 @@ pub struct GpuPatchJob {
     pub parent_offset: u32,
 }
 
+const _: () = assert!(std::mem::size_of::<GpuPatchJob>() == 32);
+
 /// `parent_slot` of a row computed by the kernel.
 pub const NO_PARENT: u32 = u32::MAX;
 

@@ -44,6 +44,9 @@ struct PushParams {
     first_job: u32,
 }
 
+/// `KernelParams` in glsl/river_kernel.glsl.
+const _: () = assert!(std::mem::size_of::<PushParams>() == 24);
+
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
 pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
