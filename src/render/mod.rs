@@ -6,5 +6,6 @@ pub mod mesh;
 pub mod presets;
 pub mod target;
 pub mod viewer;
+pub mod viewer_camera;
 
 pub use frame::{DrawnVertex, FrameStats, GpuTimes, Renderer, VertexCapture, ViewMode, WaterMode};

@@ -1,8 +1,10 @@
-//! The native viewer (winit): a fly camera whose speed scales with altitude, keys for the water mode, atmosphere,
+//! The native viewer (winit): a fly or orbit camera (viewer_camera.rs) whose speed scales with altitude, keys for
+//! the water mode, atmosphere,
 //! wireframe, level-of-detail colours, freezing the level of detail, the kernel variant and screenshots; the seed, frame and
 //! per-pass GPU times in the title bar. Survives resize and minimise.
 //!
-//! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look, Shift faster; M water mode,
+//! Keys: W/S forward/back, A/D left/right, Q/E down/up, arrows or left-drag to look (orbit mode: left-drag turns the
+//! planet), wheel zoom, C fly/orbit, Shift faster; M water mode,
 //! T atmosphere, F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
 //! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, H back to the start
 //! view, P screenshot, Escape quit.
@@ -14,7 +16,7 @@ use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::{
     application::ApplicationHandler,
     dpi::PhysicalSize,
-    event::{ElementState, MouseButton, WindowEvent},
+    event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent},
     event_loop::{ActiveEventLoop, ControlFlow, EventLoop},
     keyboard::{KeyCode, PhysicalKey},
     window::{Window, WindowId},
@@ -23,6 +25,7 @@ use winit::{
 use super::{
     frame::{FrameStats, Renderer, ViewMode},
     target::{create_depth, Offscreen, DEPTH_FORMAT},
+    viewer_camera::{CameraMode, ViewerCamera},
 };
 use crate::{
     config::LodRule,
@@ -86,7 +89,7 @@ pub fn run(
         SWAPCHAIN_FORMAT,
         DEPTH_FORMAT,
     )?;
-    let camera = FlyCamera::new(options.eye, options.look_at);
+    let camera = home(&options, world.planet.radius);
     let mut app = App {
         ctx: &ctx,
         world,
@@ -125,41 +128,15 @@ pub fn run(
     }
 }
 
-/// Position and orientation of the viewer's camera; "up" follows the planet's normal below the camera.
-struct FlyCamera {
-    position: DVec3,
-    forward: DVec3,
-}
-
-impl FlyCamera {
-    fn new(eye: DVec3, target: DVec3) -> Self {
-        Self {
-            position: eye,
-            forward: (target - eye).normalize(),
-        }
-    }
-
-    fn up(&self) -> DVec3 {
-        self.position.normalize()
-    }
-
-    fn right(&self) -> DVec3 {
-        self.forward
-            .cross(self.up())
-            .try_normalize()
-            .unwrap_or_else(|| self.forward.any_orthonormal_vector())
-    }
-
-    fn turn(&mut self, yaw: f64, pitch: f64) {
-        let up = self.up();
-        let right = self.right();
-        let f = glam::DQuat::from_axis_angle(up, -yaw) * self.forward;
-        let f = glam::DQuat::from_axis_angle(right, pitch) * f;
-        // Keep away from looking straight up or down, where "right" is undefined.
-        if f.dot(up).abs() < 0.995 {
-            self.forward = f.normalize();
-        }
-    }
+/// The start view, in orbit mode from more than half a radius up, else flying.
+fn home(options: &ViewerOptions, radius: f64) -> ViewerCamera {
+    let (eye, target) = (options.eye, options.look_at);
+    let mode = if eye.length() > 1.5 * radius {
+        CameraMode::Orbit
+    } else {
+        CameraMode::Fly
+    };
+    ViewerCamera::new(eye, target, mode)
 }
 
 struct App<'a> {
@@ -171,7 +148,7 @@ struct App<'a> {
     surface: Option<Surface>,
     swapchain: Option<Swapchain>,
     depth: Option<Image>,
-    camera: FlyCamera,
+    camera: ViewerCamera,
     keys: HashSet<KeyCode>,
     dragging: bool,
     cursor: Option<(f64, f64)>,
@@ -227,21 +204,34 @@ impl App<'_> {
 
     fn camera(&self, width: u32, height: u32) -> Camera {
         let altitude = self.altitude().max(0.01);
-        let p = self.camera.position;
-        Camera::look_at(
-            p,
-            p + self.camera.forward,
-            60.0,
+        self.camera.camera(
             width as f64 / height.max(1) as f64,
             (altitude * 0.05).clamp(0.01, 10.0),
         )
+    }
+
+    /// Keeps the camera above the ground and the water.
+    fn keep_above_ground(&mut self) {
+        let ground = self.radius()
+            + self
+                .world
+                .planet
+                .height_at(self.camera.position)
+                .max(self.world.planet.sea_level) as f64;
+        if self.camera.position.length() < ground + 0.3 {
+            self.camera.position = self.camera.radial() * (ground + 0.3);
+        }
     }
 
     fn update_camera(&mut self, dt: f64) {
         let fast =
             self.keys.contains(&KeyCode::ShiftLeft) || self.keys.contains(&KeyCode::ShiftRight);
         let speed = self.altitude().max(0.5) * if fast { 3.0 } else { 0.8 };
-        let (f, r, u) = (self.camera.forward, self.camera.right(), self.camera.up());
+        let (f, r, u) = (
+            self.camera.forward,
+            self.camera.right(),
+            self.camera.radial(),
+        );
         let mut motion = DVec3::ZERO;
         for (key, dir) in [
             (KeyCode::KeyW, f),
@@ -256,16 +246,7 @@ impl App<'_> {
             }
         }
         self.camera.position += motion * speed * dt;
-        // Never below the ground.
-        let ground = self.radius()
-            + self
-                .world
-                .planet
-                .height_at(self.camera.position)
-                .max(self.world.planet.sea_level) as f64;
-        if self.camera.position.length() < ground + 0.3 {
-            self.camera.position = self.camera.position.normalize() * (ground + 0.3);
-        }
+        self.keep_above_ground();
         let turn = 1.2 * dt;
         for (key, yaw, pitch) in [
             (KeyCode::ArrowLeft, -turn, 0.0),
@@ -337,7 +318,7 @@ impl App<'_> {
         window.set_title(&format!(
             "riverplanet | seed {} | {:.1} ms ({:.0} fps) | gpu kernel {:.2} vertices {:.1} terrain {:.1} water {:.1} sky \
              {:.1} ms | {} \
-             patches ({} new) | altitude {:.1} | water {:?}{}{}{}",
+             patches ({} new) | altitude {:.1} | {:?} | water {:?}{}{}{}",
             self.world.seed,
             self.smoothed_ms,
             1000.0 / self.smoothed_ms.max(1e-3),
@@ -349,6 +330,7 @@ impl App<'_> {
             stats.visible_patches,
             stats.new_patches,
             self.altitude(),
+            self.camera.mode,
             renderer.map(|r| r.water_mode).unwrap_or(super::WaterMode::Auto),
             if renderer.is_some_and(|r| r.freeze_lod) { " | lod frozen" } else { "" },
             if renderer.is_some_and(|r| r.variant == KernelVariant::Simple) { " | simple kernel" } else { "" },
@@ -402,7 +384,13 @@ impl App<'_> {
         match code {
             KeyCode::Escape => event_loop.exit(),
             // Home: back to the start view, wherever the flight went.
-            KeyCode::KeyH => self.camera = FlyCamera::new(self.options.eye, self.options.look_at),
+            KeyCode::KeyH => self.camera = home(&self.options, self.radius()),
+            KeyCode::KeyC => {
+                self.camera.mode = match self.camera.mode {
+                    CameraMode::Fly => CameraMode::Orbit,
+                    CameraMode::Orbit => CameraMode::Fly,
+                }
+            }
             KeyCode::KeyM => renderer.water_mode = renderer.water_mode.next(),
             KeyCode::KeyT => renderer.atmosphere_on = !renderer.atmosphere_on,
             KeyCode::KeyF => renderer.wireframe_on = !renderer.wireframe_on,
@@ -533,10 +521,19 @@ impl ApplicationHandler for App<'_> {
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if let (true, Some((x, y))) = (self.dragging, self.cursor) {
-                    self.camera
-                        .turn((position.x - x) * 0.004, -(position.y - y) * 0.004);
+                    let altitude = self.altitude();
+                    self.camera.drag(position.x - x, position.y - y, altitude);
                 }
                 self.cursor = Some((position.x, position.y));
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                let altitude = self.altitude();
+                self.camera.zoom(lines, altitude);
+                self.keep_above_ground();
             }
             WindowEvent::RedrawRequested => {
                 if let Err(e) = self.draw() {
