@@ -1,9 +1,10 @@
-//! The windowed viewer under Xvfb: 60 frames, a screenshot, a clean exit (no validation error).
+//! The windowed viewer under Xvfb: 60 frames, a screenshot with its camera sidecar, a clean exit (no validation
+//! error); the sidecar's `render` command makes the same picture.
 
 use std::process::Command;
 
 #[test]
-fn viewer_runs_60_frames_under_xvfb_and_exits_cleanly() {
+fn viewer_runs_60_frames_under_xvfb_and_its_screenshot_sidecar_renders_the_same_view() {
     let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
     if Command::new("xvfb-run").arg("--help").output().is_err() {
         assert!(
@@ -45,6 +46,46 @@ fn viewer_runs_60_frames_under_xvfb_and_exits_cleanly() {
     assert!(
         image.pixels().any(|p| p != first),
         "the screenshot is one flat colour"
+    );
+    // The sidecar: the seed, the camera (orbit mode from three radii out), and a command that renders the view.
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("shot.json")).unwrap()).unwrap();
+    assert_eq!(sidecar["seed"], 3);
+    assert_eq!(sidecar["camera"]["mode"], "Orbit");
+    let command = sidecar["render"].as_str().unwrap();
+    let mut args: Vec<String> = command
+        .split_whitespace()
+        .skip(1)
+        .map(String::from)
+        .collect();
+    assert_eq!(args[0], "render", "{command}");
+    let out = args.iter().position(|a| a == "--out").unwrap() + 1;
+    args[out] = dir.join("again.png").display().to_string();
+    let again = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
+        .args(&args)
+        .output()
+        .unwrap();
+    assert!(
+        again.status.success(),
+        "{command}: {}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    let rendered = image::open(dir.join("again.png")).unwrap().to_rgba8();
+    assert_eq!(rendered.dimensions(), image.dimensions());
+    let differing = image
+        .pixels()
+        .zip(rendered.pixels())
+        .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 24))
+        .count();
+    let share = differing as f64 / (image.width() * image.height()) as f64;
+    eprintln!(
+        "the sidecar's render differs in {:.2} % of the pixels",
+        share * 100.0
+    );
+    assert!(
+        share < 0.02,
+        "the sidecar's command renders another view ({:.1} % of the pixels differ)",
+        share * 100.0
     );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -194,6 +194,10 @@ pub struct ViewArgs {
     pub frames: Option<u64>,
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// Where P writes its screenshots (created when the first is taken), each with a JSON sidecar that holds the
+    /// seed, the camera and the `render` command that makes the same image.
+    #[arg(long, default_value = "out")]
+    pub screenshots: PathBuf,
 }
 
 /// A feature that is on unless switched off.

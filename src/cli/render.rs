@@ -153,6 +153,8 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
             look_at,
             frames: args.frames,
             screenshot: args.screenshot.clone(),
+            screenshots: args.screenshots.clone(),
+            config: args.planet.config.clone(),
             water: args.water,
             atmosphere: args.atmosphere.on(),
             flowing_water: args.flowing_water.on(),

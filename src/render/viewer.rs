@@ -59,8 +59,12 @@ pub struct ViewerOptions {
     pub look_at: DVec3,
     /// Stop after this many frames (for tests under Xvfb).
     pub frames: Option<u64>,
-    /// Written after the last frame (with `frames`) or on P.
+    /// Written after the last frame (with `frames`).
     pub screenshot: Option<PathBuf>,
+    /// Where P writes screenshots, with a JSON sidecar each.
+    pub screenshots: PathBuf,
+    /// The configuration file given, for the sidecar's `render` command (`None`: the default).
+    pub config: Option<PathBuf>,
     pub water: super::WaterMode,
     pub atmosphere: bool,
     pub flowing_water: bool,
@@ -339,11 +343,15 @@ impl App<'_> {
     }
 
     /// Renders the current view offscreen at the window's size and writes it as PNG.
-    fn screenshot(&mut self, path: &std::path::Path) -> Result<(), ViewerError> {
-        let [w, h] = self
-            .swapchain
+    /// The window's size, or the requested one before the window has a swapchain.
+    fn screenshot_size(&self) -> [u32; 2] {
+        self.swapchain
             .as_ref()
-            .map_or(self.options.size, |s| [s.extent.width, s.extent.height]);
+            .map_or(self.options.size, |s| [s.extent.width, s.extent.height])
+    }
+
+    fn screenshot(&mut self, path: &std::path::Path) -> Result<(), ViewerError> {
+        let [w, h] = self.screenshot_size();
         let camera = self.camera(w, h);
         let Some(renderer) = &mut self.renderer else {
             return Ok(());
@@ -369,12 +377,71 @@ impl App<'_> {
         })();
         target.destroy(self.ctx);
         let image = result?;
-        crate::export::files::save_image(&image, path).map_err(|e| ViewerError::Screenshot {
+        let error = |path: &std::path::Path, e: &dyn std::fmt::Display| ViewerError::Screenshot {
             path: path.display().to_string(),
             message: e.to_string(),
-        })?;
-        println!("screenshot: {}", path.display());
+        };
+        crate::export::files::save_image(&image, path).map_err(|e| error(path, &e))?;
+        let sidecar = path.with_extension("json");
+        let text =
+            serde_json::to_string_pretty(&self.sidecar(path)).map_err(|e| error(&sidecar, &e))?;
+        crate::export::files::write_bytes(&sidecar, text.as_bytes())
+            .map_err(|e| error(&sidecar, &e))?;
+        println!(
+            "screenshot: {} (camera: {})",
+            path.display(),
+            sidecar.display()
+        );
         Ok(())
+    }
+
+    /// P: a screenshot into the screenshot folder, named by seed and frame.
+    fn screenshot_into_folder(&mut self) -> Result<(), ViewerError> {
+        let dir = self.options.screenshots.clone();
+        std::fs::create_dir_all(&dir).map_err(|e| ViewerError::Screenshot {
+            path: dir.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let path = dir.join(format!(
+            "riverplanet-seed{}-frame{}.png",
+            self.world.seed, self.frames
+        ));
+        self.screenshot(&path)
+    }
+
+    /// The JSON sidecar of a screenshot at `image`: the seed, the camera, and the `render` command that makes the
+    /// same image.
+    fn sidecar(&self, image: &std::path::Path) -> serde_json::Value {
+        let c = &self.camera;
+        let target = c.position + c.forward * self.altitude().max(1.0);
+        let vector = |v: DVec3| format!("{},{},{}", v.x, v.y, v.z);
+        let [w, h] = self.screenshot_size();
+        let config = self
+            .options
+            .config
+            .as_ref()
+            .map_or(String::new(), |c| format!(" --config {}", c.display()));
+        let name = image
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        serde_json::json!({
+            "image": name,
+            "seed": self.world.seed,
+            "frame": self.frames,
+            "camera": {
+                "mode": format!("{:?}", c.mode),
+                "position": [c.position.x, c.position.y, c.position.z],
+                "forward": [c.forward.x, c.forward.y, c.forward.z],
+                "up": [c.up.x, c.up.y, c.up.z],
+                "altitude": self.altitude(),
+            },
+            "render": format!(
+                "riverplanet render{config} --seed {} --size {w}x{h} --eye={} --look-at={} --fov 60 --out {name}",
+                self.world.seed,
+                vector(c.position),
+                vector(target)
+            ),
+        })
     }
 
     fn key(&mut self, event_loop: &ActiveEventLoop, code: KeyCode) {
@@ -423,8 +490,7 @@ impl App<'_> {
                 }
             }
             KeyCode::KeyP => {
-                let path = PathBuf::from(format!("riverplanet-{}.png", self.frames));
-                if let Err(e) = self.screenshot(&path) {
+                if let Err(e) = self.screenshot_into_folder() {
                     self.fail(event_loop, e);
                 }
             }
