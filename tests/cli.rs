@@ -423,6 +423,64 @@ fn cameras_take_negative_coordinates_and_a_preset_refuses_an_eye() {
     assert!(!dir.join("preset.png").exists());
 }
 
+/// `render --up` sets the screen's up (the viewer's screenshot sidecars pass it): the opposite up shows the same view
+/// turned by half a turn; an up along the view is refused before any work.
+#[test]
+fn render_up_turns_the_view_and_an_up_along_it_is_refused() {
+    let dir = temp_dir("up");
+    let render = |up: &str, name: &str| {
+        riverplanet()
+            .args([
+                "render",
+                "--seed",
+                "1",
+                "--eye",
+                "0,1200,3400",
+                "--look-at",
+                "0,0,0",
+            ])
+            .args([
+                "--sun-elevation",
+                "30",
+                "--size",
+                "64x36",
+                "--up",
+                up,
+                "--out",
+            ])
+            .arg(dir.join(name))
+            .output()
+            .unwrap()
+    };
+    for (up, name) in [("1,0,0", "a.png"), ("-1,0,0", "b.png")] {
+        let run = render(up, name);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    let a = image::open(dir.join("a.png")).unwrap().to_rgba8();
+    let b = image::open(dir.join("b.png")).unwrap().to_rgba8();
+    let (w, h) = a.dimensions();
+    let differing = a
+        .enumerate_pixels()
+        .filter(|(x, y, p)| {
+            let q = b.get_pixel(w - 1 - x, h - 1 - y);
+            (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 24)
+        })
+        .count();
+    assert!(
+        differing * 50 < (w * h) as usize,
+        "{differing} pixels differ from the view turned by half a turn"
+    );
+    let along = render("0,-1200,-3400", "c.png");
+    let stderr = String::from_utf8_lossy(&along.stderr);
+    assert_eq!(along.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--up"), "{stderr}");
+    assert!(!dir.join("c.png").exists());
+}
+
 #[test]
 fn benchmark_counts_and_speeds_must_be_positive() {
     for (option, args) in [

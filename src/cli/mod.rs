@@ -121,9 +121,13 @@ pub struct RenderArgs {
     pub eye: glam::DVec3,
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
     pub look_at: glam::DVec3,
+    /// The screen's up [default: towards the planet's outward normal at the eye, or any direction across the view
+    /// when that is straight down]; the viewer's screenshot sidecars give it, so their views keep their roll.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<glam::DVec3>,
     /// Place the camera from the planet's own features instead of --eye/--look-at: `orbit` (the first river's
     /// side of the planet), `mountains` (above the first river's source), `river` (close above the first river).
-    #[arg(long, value_enum, conflicts_with_all = ["eye", "look_at"])]
+    #[arg(long, value_enum, conflicts_with_all = ["eye", "look_at", "up"])]
     pub preset: Option<riverplanet::render::presets::Preset>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 45.0)]

@@ -11,6 +11,14 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     if args.preset.is_none() {
         check_camera(args.eye, args.look_at, &config)?;
     }
+    if let Some(up) = args.up {
+        let forward = (args.look_at - args.eye).normalize_or_zero();
+        if up.cross(forward).length() < 1e-6 * up.length() || up.length() == 0.0 {
+            return Err(usage(format!(
+                "--up {up} must be a direction across the view (not zero, not along --look-at minus --eye)"
+            )));
+        }
+    }
     if !(1.0..=170.0).contains(&args.fov) {
         return Err(usage(format!(
             "--fov {} must be in [1, 170] degrees",
@@ -61,13 +69,16 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         renderer.lod_rule = rule;
     }
     let altitude = eye.length() - config.planet.radius as f64;
-    let camera = riverplanet::runtime::camera::Camera::look_at(
+    let mut camera = riverplanet::runtime::camera::Camera::look_at(
         eye,
         look_at,
         args.fov,
         w as f64 / h as f64,
         (altitude * 0.05).clamp(0.01, 10.0),
     );
+    if let Some(up) = args.up {
+        camera.up = up.normalize();
+    }
     let c = args.clear_color;
     let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
     let mut layout = gpu::vk::ImageLayout::UNDEFINED;

@@ -436,10 +436,11 @@ impl App<'_> {
                 "altitude": self.altitude(),
             },
             "render": format!(
-                "riverplanet render{config} --seed {} --size {w}x{h} --eye={} --look-at={} --fov 60 --out {name}",
+                "riverplanet render{config} --seed {} --size {w}x{h} --eye={} --look-at={} --up={} --fov 60 --out {name}",
                 self.world.seed,
                 vector(c.position),
-                vector(target)
+                vector(target),
+                vector(c.up)
             ),
         })
     }
