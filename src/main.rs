@@ -19,6 +19,13 @@ use cli::{
 };
 
 fn main() -> ExitCode {
+    // SAFETY: the first thing the program does, before any thread starts. The default action of SIGPIPE (which
+    // Rust's runtime sets to ignore) ends the program quietly when what reads its output goes away
+    // (`riverplanet render ... | head -1`), as other command-line tools do, instead of a panic in println!.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let mut options = ContextOptions::from_env();

@@ -481,6 +481,22 @@ fn render_up_turns_the_view_and_an_up_along_it_is_refused() {
     assert!(!dir.join("c.png").exists());
 }
 
+/// Output into a pipe whose reader went away (`riverplanet ... | head -1`) ends the program quietly, without a panic.
+#[test]
+fn a_closed_output_pipe_ends_the_program_without_a_panic() {
+    let mut child = riverplanet()
+        .args(["generate", "--seed", "2", "--level", "0", "--out"])
+        .arg(temp_dir("pipe"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
 #[test]
 fn benchmark_counts_and_speeds_must_be_positive() {
     for (option, args) in [
