@@ -169,36 +169,29 @@ fn the_drainage_rivers_export_as_rfc_7946_with_bed_heights_and_lakes() {
 #[test]
 fn export_rivers_refuses_what_it_cannot_write_before_any_work() {
     let dir = temp_dir("refused");
-    let run = |args: &[&str]| riverplanet().args(args).output().unwrap();
     let png = dir.join("rivers.png");
-    let wrong_name = run(&["export", "rivers", "--out", png.to_str().unwrap()]);
-    assert_eq!(wrong_name.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&wrong_name.stderr).contains(".geojson"));
-    assert!(!png.exists(), "wrote {}", png.display());
     let geojson = dir.join("rivers.geojson");
-    // The default planet uses the drainage model, whose rivers have one level.
-    let level = run(&[
-        "export",
-        "rivers",
-        "--level",
-        "3",
-        "--out",
-        geojson.to_str().unwrap(),
-    ]);
-    assert_eq!(level.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&level.stderr).contains("--level 3"));
     let thesis = concat!(env!("CARGO_MANIFEST_DIR"), "/config/thesis.xml");
-    let deep = run(&[
-        "export",
-        "rivers",
-        "--config",
-        thesis,
-        "--level",
-        "9",
-        "--out",
-        geojson.to_str().unwrap(),
-    ]);
-    assert_eq!(deep.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&deep.stderr).contains("[0, 8]"));
-    assert!(!geojson.exists());
+    // (arguments, the output, what the message names). The default planet uses the drainage model, whose rivers
+    // have one level.
+    let cases: [(Vec<&str>, &std::path::Path, &str); 3] = [
+        (vec![], &png, ".geojson"),
+        (vec!["--level", "3"], &geojson, "--level 3"),
+        (vec!["--config", thesis, "--level", "9"], &geojson, "[0, 8]"),
+    ];
+    for (args, out, culprit) in cases {
+        let run = riverplanet()
+            .args(["export", "rivers"])
+            .args(&args)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap();
+        assert_eq!(run.status.code(), Some(2), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&run.stderr).contains(culprit),
+            "{args:?}"
+        );
+        assert!(!out.exists(), "wrote {}", out.display());
+    }
 }

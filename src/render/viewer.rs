@@ -132,6 +132,13 @@ pub fn run(
     }
 }
 
+fn screenshot_error(path: &std::path::Path, e: impl std::fmt::Display) -> ViewerError {
+    ViewerError::Screenshot {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
 /// The start view, in orbit mode from more than half a radius up, else flying.
 fn home(options: &ViewerOptions, radius: f64) -> ViewerCamera {
     let (eye, target) = (options.eye, options.look_at);
@@ -342,7 +349,6 @@ impl App<'_> {
         ));
     }
 
-    /// Renders the current view offscreen at the window's size and writes it as PNG.
     /// The window's size, or the requested one before the window has a swapchain.
     fn screenshot_size(&self) -> [u32; 2] {
         self.swapchain
@@ -350,6 +356,8 @@ impl App<'_> {
             .map_or(self.options.size, |s| [s.extent.width, s.extent.height])
     }
 
+    /// Renders the current view offscreen at the window's size, writes it as PNG and beside it its JSON sidecar
+    /// (`ViewerCamera::sidecar`).
     fn screenshot(&mut self, path: &std::path::Path) -> Result<(), ViewerError> {
         let [w, h] = self.screenshot_size();
         let camera = self.camera(w, h);
@@ -377,16 +385,22 @@ impl App<'_> {
         })();
         target.destroy(self.ctx);
         let image = result?;
-        let error = |path: &std::path::Path, e: &dyn std::fmt::Display| ViewerError::Screenshot {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        };
-        crate::export::files::save_image(&image, path).map_err(|e| error(path, &e))?;
+        crate::export::files::save_image(&image, path).map_err(|e| screenshot_error(path, e))?;
         let sidecar = path.with_extension("json");
+        let name = path
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let bookmark = self.camera.sidecar(
+            &name,
+            (self.world.seed, self.frames),
+            self.altitude(),
+            [w, h],
+            self.options.config.as_deref(),
+        );
         let text =
-            serde_json::to_string_pretty(&self.sidecar(path)).map_err(|e| error(&sidecar, &e))?;
+            serde_json::to_string_pretty(&bookmark).map_err(|e| screenshot_error(&sidecar, e))?;
         crate::export::files::write_bytes(&sidecar, text.as_bytes())
-            .map_err(|e| error(&sidecar, &e))?;
+            .map_err(|e| screenshot_error(&sidecar, e))?;
         println!(
             "screenshot: {} (camera: {})",
             path.display(),
@@ -398,51 +412,12 @@ impl App<'_> {
     /// P: a screenshot into the screenshot folder, named by seed and frame.
     fn screenshot_into_folder(&mut self) -> Result<(), ViewerError> {
         let dir = self.options.screenshots.clone();
-        std::fs::create_dir_all(&dir).map_err(|e| ViewerError::Screenshot {
-            path: dir.display().to_string(),
-            message: e.to_string(),
-        })?;
+        std::fs::create_dir_all(&dir).map_err(|e| screenshot_error(&dir, e))?;
         let path = dir.join(format!(
             "riverplanet-seed{}-frame{}.png",
             self.world.seed, self.frames
         ));
         self.screenshot(&path)
-    }
-
-    /// The JSON sidecar of a screenshot at `image`: the seed, the camera, and the `render` command that makes the
-    /// same image.
-    fn sidecar(&self, image: &std::path::Path) -> serde_json::Value {
-        let c = &self.camera;
-        let target = c.position + c.forward * self.altitude().max(1.0);
-        let vector = |v: DVec3| format!("{},{},{}", v.x, v.y, v.z);
-        let [w, h] = self.screenshot_size();
-        let config = self
-            .options
-            .config
-            .as_ref()
-            .map_or(String::new(), |c| format!(" --config {}", c.display()));
-        let name = image
-            .file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-        serde_json::json!({
-            "image": name,
-            "seed": self.world.seed,
-            "frame": self.frames,
-            "camera": {
-                "mode": format!("{:?}", c.mode),
-                "position": [c.position.x, c.position.y, c.position.z],
-                "forward": [c.forward.x, c.forward.y, c.forward.z],
-                "up": [c.up.x, c.up.y, c.up.z],
-                "altitude": self.altitude(),
-            },
-            "render": format!(
-                "riverplanet render{config} --seed {} --size {w}x{h} --eye={} --look-at={} --up={} --fov 60 --out {name}",
-                self.world.seed,
-                vector(c.position),
-                vector(target),
-                vector(c.up)
-            ),
-        })
     }
 
     fn key(&mut self, event_loop: &ActiveEventLoop, code: KeyCode) {

@@ -2,6 +2,8 @@
 //! look with arrows or a drag) and orbit (a drag turns the view around the planet's centre, as a globe turns under
 //! the hand); in both, the wheel zooms towards or away from the ground, and speeds follow the altitude.
 
+use std::path::Path;
+
 use glam::{DQuat, DVec3};
 
 use crate::runtime::camera::Camera;
@@ -14,6 +16,9 @@ pub enum CameraMode {
     /// A drag turns the view around the planet's centre.
     Orbit,
 }
+
+/// The viewer's vertical field of view, degrees.
+pub const FOV_DEGREES: f64 = 60.0;
 
 /// Radians per pixel of a drag (fly: the view turns; orbit: at an altitude of one planet radius or more).
 const DRAG_RADIANS: f64 = 0.004;
@@ -113,6 +118,41 @@ impl ViewerCamera {
         );
         camera.up = self.up;
         camera
+    }
+
+    /// The JSON sidecar of a screenshot `image` of this view (beyond the thesis: a bookmark): the `seed` and
+    /// `frame`, the camera, and the `render` command (with `config` where one was given) that makes the same
+    /// image of `size` pixels.
+    pub fn sidecar(
+        &self,
+        image: &str,
+        (seed, frame): (u32, u64),
+        altitude: f64,
+        [w, h]: [u32; 2],
+        config: Option<&Path>,
+    ) -> serde_json::Value {
+        let target = self.position + self.forward * altitude.max(1.0);
+        let vector = |v: DVec3| format!("{},{},{}", v.x, v.y, v.z);
+        let config = config.map_or(String::new(), |c| format!(" --config {}", c.display()));
+        serde_json::json!({
+            "image": image,
+            "seed": seed,
+            "frame": frame,
+            "camera": {
+                "mode": format!("{:?}", self.mode),
+                "position": [self.position.x, self.position.y, self.position.z],
+                "forward": [self.forward.x, self.forward.y, self.forward.z],
+                "up": [self.up.x, self.up.y, self.up.z],
+                "altitude": altitude,
+            },
+            "render": format!(
+                "riverplanet render{config} --seed {seed} --size {w}x{h} --eye={} --look-at={} --up={} \
+                 --fov {FOV_DEGREES} --out {image}",
+                vector(self.position),
+                vector(target),
+                vector(self.up)
+            ),
+        })
     }
 }
 
