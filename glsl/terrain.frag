@@ -118,14 +118,13 @@ vec3 flowingNormal(vec3 up, vec3 q0, vec3 q1, float w0, float strength) {
     return normalize(up - strength * (g - up * dot(g, up)));
 }
 
-// The air between the eye and the surface: what it lets through plus what it scatters towards the eye
-// (atmosphere.glsl); without an atmosphere, a constant haze that grows with distance.
+// The air between the eye and the surface: what it lets through plus what it scatters towards the eye (both per
+// vertex, atmosphere.glsl and terrain_interface.glsl); without an atmosphere, a constant haze that grows with distance.
 vec3 throughAir(vec3 colour) {
     if (!atmosphereOn()) {
         return mix(colour, vec3(0.55, 0.65, 0.8), clamp(length(fPosition) / (frame.planet.x * 6.0), 0.0, 0.35));
     }
-    float c = dot(normalize(fPosition), normalize(frame.sun.xyz));
-    return colour * fTransmittance + toneMap(inscattered(fInscatterRayleigh, fInscatterMie, c));
+    return colour * fTransmittance + toneMap(fInscatter);
 }
 
 // Beyond the thesis: the lit colour and opacity of water, flowing unless still (the thesis's, Section 8.4): the

@@ -1,4 +1,4 @@
-// What terrain.frag reads, written by terrain.vert (terrain pass) and terrain.geom (water pass), packed into few
+// What terrain.frag reads, written by terrain.vert (terrain pass) and terrain.geom (water pass), packed into eight
 // vec4 slots: lavapipe's draw module and triangle setup work per slot, per vertex and per triangle, on one thread
 // (docs/rendering.md, "The patch mesh and the shaders"). Writers define TERRAIN_WRITER before including it.
 // Needs atmosphere.glsl.
@@ -14,10 +14,9 @@ layout(location = 1) TERRAIN_IO vec4 ioNormalFlowY;     // the surface normal; t
 layout(location = 2) TERRAIN_IO vec4 ioRiver;           // final height, water height, signed distance, half width
 layout(location = 3) TERRAIN_IO vec4 ioDirectionFlowZ;  // unit direction from the planet centre; the flow's z
 layout(location = 4) TERRAIN_IO vec4 ioDetailSunR;      // world position mod DETAIL_PERIOD; the sunlight's red
-layout(location = 5) TERRAIN_IO vec4 ioRayleighSunG;    // the air's inscattering (atmosphere.glsl); sunlight green
-layout(location = 6) TERRAIN_IO vec4 ioMieSunB;         // and Mie; the sunlight's blue
-layout(location = 7) TERRAIN_IO vec3 ioTransmittance;   // the air's transmittance from the eye
-layout(location = 8) flat TERRAIN_IO vec3 ioFlat;       // river water (1) or not (0), the level, the vertex spacing
+layout(location = 5) TERRAIN_IO vec4 ioInscatterSunG;   // radiance the air scatters towards the eye; sunlight green
+layout(location = 6) TERRAIN_IO vec4 ioTransmittanceSunB; // the air's transmittance from the eye; sunlight blue
+layout(location = 7) flat TERRAIN_IO vec3 ioFlat;       // river water (1) or not (0), the level, the vertex spacing
 
 // One vertex of what terrain.frag reads.
 struct SurfaceVertex {
@@ -35,15 +34,18 @@ struct SurfaceVertex {
 };
 
 #ifdef TERRAIN_WRITER
+// The phase functions are applied per vertex: the angle between the view ray and the sun changes slowly across a
+// triangle, and a fragment is shaded several times as often as a vertex (one slot and two phase functions less
+// per fragment on lavapipe).
 void writeSurface(SurfaceVertex v) {
+    float c = dot(normalize(v.position), normalize(frame.sun.xyz));
     ioPositionFlowX = vec4(v.position, v.flow.x);
     ioNormalFlowY = vec4(v.normal, v.flow.y);
     ioRiver = v.river;
     ioDirectionFlowZ = vec4(v.direction, v.flow.z);
     ioDetailSunR = vec4(v.detail, v.sunlight.r);
-    ioRayleighSunG = vec4(v.air.rayleigh, v.sunlight.g);
-    ioMieSunB = vec4(v.air.mie, v.sunlight.b);
-    ioTransmittance = v.air.transmittance;
+    ioInscatterSunG = vec4(inscattered(v.air.rayleigh, v.air.mie, c), v.sunlight.g);
+    ioTransmittanceSunB = vec4(v.air.transmittance, v.sunlight.b);
     ioFlat = vec3(v.riverWater ? 1.0 : 0.0, v.level, v.spacing);
 }
 #else
@@ -53,10 +55,9 @@ void writeSurface(SurfaceVertex v) {
 #define fDirection ioDirectionFlowZ.xyz
 #define fDetail ioDetailSunR.xyz
 #define fFlow vec3(ioPositionFlowX.w, ioNormalFlowY.w, ioDirectionFlowZ.w)
-#define fSunlight vec3(ioDetailSunR.w, ioRayleighSunG.w, ioMieSunB.w)
-#define fInscatterRayleigh ioRayleighSunG.xyz
-#define fInscatterMie ioMieSunB.xyz
-#define fTransmittance ioTransmittance
+#define fSunlight vec3(ioDetailSunR.w, ioInscatterSunG.w, ioTransmittanceSunB.w)
+#define fInscatter ioInscatterSunG.xyz
+#define fTransmittance ioTransmittanceSunB.xyz
 #define fRiverWater ioFlat.x
 #define fLevel ioFlat.y
 #define fSpacing ioFlat.z
