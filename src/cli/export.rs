@@ -1,6 +1,15 @@
 //! `riverplanet export`: the planet in forms other tools read (beyond the thesis).
 
-use riverplanet::{export, world::World};
+use std::path::Path;
+
+use riverplanet::{
+    export::{
+        self,
+        carved::{carved_terrain, MAX_EXPORT_LEVEL},
+        heightmaps::{planet_metadata, write_equirect, write_faces},
+    },
+    world::World,
+};
 
 use super::ExportCommand;
 use crate::{load_config, planet_seed, usage};
@@ -10,41 +19,133 @@ const MAX_RIVER_LEVEL: u32 = 8;
 
 pub fn export(what: ExportCommand) -> anyhow::Result<()> {
     match what {
-        ExportCommand::Rivers { planet, level, out } => {
-            let (config, source) = load_config(planet.config.as_deref())?;
-            export::files::check_output("--out", &out, false).map_err(usage)?;
-            let geojson_name = out.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-                e.eq_ignore_ascii_case("geojson") || e.eq_ignore_ascii_case("json")
-            });
-            if !geojson_name {
-                return Err(usage(format!(
-                    "--out {}: rivers are written as GeoJSON; the name must end in .geojson or .json",
-                    out.display()
-                )));
-            }
-            let drainage = config.river.model == riverplanet::config::RiverModel::Drainage;
-            if let (Some(level), true) = (level, drainage) {
-                return Err(usage(format!(
-                    "--level {level}: {source} uses the drainage river model, whose reaches have one level; \
-                     --level refines the thesis's model (river-model thesis)"
-                )));
-            }
-            let level = level.unwrap_or(config.river.hull_levels);
-            if level > MAX_RIVER_LEVEL {
-                return Err(usage(format!(
-                    "--level {level} must be in [0, {MAX_RIVER_LEVEL}]"
-                )));
-            }
+        ExportCommand::Faces {
+            planet,
+            level,
+            format,
+            out,
+        } => {
+            check_level(level)?;
+            export::files::check_folder("--out", &out).map_err(usage)?;
+            let (config, _) = load_config(planet.config.as_deref())?;
             let seed = planet_seed(planet.seed, &config);
             let world = World::build(&config, seed)?;
-            let geojson = match &world.planet.drainage {
-                Some(drainage) => export::drainage::drainage_geojson(drainage, &config),
-                None => export::rivers_geojson(&world.network, level, world.planet.radius),
-            };
-            let features = geojson["features"].as_array().map_or(0, Vec::len);
-            export::files::write_bytes(&out, serde_json::to_string(&geojson)?.as_bytes())?;
-            println!("{}: {features} features", out.display());
+            let lattice = carved_terrain(&world.planet, &world.network, &config, level);
+            std::fs::create_dir_all(&out)
+                .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
+            let metadata = planet_metadata(&world.planet, seed, level, true);
+            let layout = write_faces(&lattice, format, &out, &metadata)?;
+            println!(
+                "{}: 6 faces of {side} x {side} at level {level}, heights {} to {}",
+                out.display(),
+                layout["min_height"],
+                layout["max_height"],
+                side = lattice.side(),
+            );
             Ok(())
         }
+        ExportCommand::Equirect {
+            planet,
+            size: [width, height],
+            level,
+            format,
+            out,
+        } => {
+            if width < 2 || height < 2 {
+                return Err(usage(format!(
+                    "--size {width}x{height}: both must be at least 2"
+                )));
+            }
+            let level = level.unwrap_or_else(|| equirect_level(width));
+            check_level(level)?;
+            export::files::check_output("--out", &out, false).map_err(usage)?;
+            if !format.names(&out) {
+                return Err(usage(format!(
+                    "--out {}: --format {} writes .{} files",
+                    out.display(),
+                    format.name(),
+                    format.extension()
+                )));
+            }
+            let (config, _) = load_config(planet.config.as_deref())?;
+            let seed = planet_seed(planet.seed, &config);
+            let world = World::build(&config, seed)?;
+            let lattice = carved_terrain(&world.planet, &world.network, &config, level);
+            let metadata = planet_metadata(&world.planet, seed, level, true);
+            let written = write_equirect(
+                &lattice,
+                (width, height),
+                format,
+                &out,
+                &metadata,
+                world.planet.radius,
+            )?;
+            println!(
+                "{}: {width} x {height} from level {level}, heights {} to {}; metadata in {}",
+                out.display(),
+                written["min_height"],
+                written["max_height"],
+                out.with_extension("json").display()
+            );
+            Ok(())
+        }
+        ExportCommand::Rivers { planet, level, out } => export_rivers(planet, level, &out),
     }
+}
+
+fn check_level(level: u32) -> anyhow::Result<()> {
+    if level > MAX_EXPORT_LEVEL {
+        return Err(usage(format!(
+            "--level {level} must be in [0, {MAX_EXPORT_LEVEL}] (level 7: 6 faces of 4097 x 4097 heights)"
+        )));
+    }
+    Ok(())
+}
+
+/// The coarsest level whose vertices lie no farther apart than an equirectangular raster `width` pixels wide
+/// samples the equator: a face spans 90 degrees in 32 x 2^level cells, the raster in width / 4 pixels.
+fn equirect_level(width: u32) -> u32 {
+    let mut level = 0;
+    while (32u32 << level) < width.div_ceil(4) && level < MAX_EXPORT_LEVEL {
+        level += 1;
+    }
+    level
+}
+
+fn export_rivers(planet: super::PlanetArgs, level: Option<u32>, out: &Path) -> anyhow::Result<()> {
+    let (config, source) = load_config(planet.config.as_deref())?;
+    export::files::check_output("--out", out, false).map_err(usage)?;
+    let geojson_name = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("geojson") || e.eq_ignore_ascii_case("json"));
+    if !geojson_name {
+        return Err(usage(format!(
+            "--out {}: rivers are written as GeoJSON; the name must end in .geojson or .json",
+            out.display()
+        )));
+    }
+    let drainage = config.river.model == riverplanet::config::RiverModel::Drainage;
+    if let (Some(level), true) = (level, drainage) {
+        return Err(usage(format!(
+            "--level {level}: {source} uses the drainage river model, whose reaches have one level; \
+             --level refines the thesis's model (river-model thesis)"
+        )));
+    }
+    let level = level.unwrap_or(config.river.hull_levels);
+    if level > MAX_RIVER_LEVEL {
+        return Err(usage(format!(
+            "--level {level} must be in [0, {MAX_RIVER_LEVEL}]"
+        )));
+    }
+    let seed = planet_seed(planet.seed, &config);
+    let world = World::build(&config, seed)?;
+    let geojson = match &world.planet.drainage {
+        Some(drainage) => export::drainage::drainage_geojson(drainage, &config),
+        None => export::rivers_geojson(&world.network, level, world.planet.radius),
+    };
+    let features = geojson["features"].as_array().map_or(0, Vec::len);
+    export::files::write_bytes(out, serde_json::to_string(&geojson)?.as_bytes())?;
+    println!("{}: {features} features", out.display());
+    Ok(())
 }

@@ -61,7 +61,16 @@ pub fn generate(
     let faces = planet.face_lattice(level);
     let faces_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = std::time::Instant::now();
-    riverplanet::export::write_faces(&faces, level, out)?;
+    let faces_dir = out.join("faces");
+    std::fs::create_dir_all(&faces_dir)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", faces_dir.display()))?;
+    let metadata = riverplanet::export::heightmaps::planet_metadata(&planet, seed, level, false);
+    riverplanet::export::heightmaps::write_faces(
+        &faces,
+        riverplanet::export::raster::RasterFormat::Png,
+        &faces_dir,
+        &metadata,
+    )?;
     if preview {
         let path = out.join("preview.png");
         let mut image = riverplanet::export::preview(&planet, 256);

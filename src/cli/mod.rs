@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 use riverplanet::{
     config::LodRule,
+    export::raster::RasterFormat,
     kernel::gpu::KernelTuning,
     render::{ViewMode, WaterMode},
 };
@@ -232,6 +233,41 @@ pub struct PlanetArgs {
 /// What `riverplanet export` writes.
 #[derive(Subcommand)]
 pub enum ExportCommand {
+    /// The terrain with the rivers carved in (as the renderer draws it) at one level of detail, as six cube-face
+    /// rasters face{0..5}.tif (32-bit float) or .png (16-bit) and layout.json: radius, units, sea level, how
+    /// values turn into heights, and each face's orientation.
+    Faces {
+        #[command(flatten)]
+        planet: PlanetArgs,
+        /// Level of detail, 0 to 7: faces of 32 x 2^level + 1 pixels a side.
+        #[arg(long, default_value_t = 4)]
+        level: u32,
+        /// tiff (32-bit float heights) or png (16-bit grey, one height range for all faces).
+        #[arg(long, value_parser = RasterFormat::parse, default_value = "tiff")]
+        format: RasterFormat,
+        /// The folder to write into (made if missing; its parent must exist).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// The whole planet's terrain with the rivers carved in, as one longitude-latitude raster (GeoTIFF with its
+    /// georeference, or 16-bit PNG) and its metadata beside it (the same name with .json).
+    Equirect {
+        #[command(flatten)]
+        planet: PlanetArgs,
+        /// WxH pixels.
+        #[arg(long, value_parser = parse_size, default_value = "2048x1024")]
+        size: [u32; 2],
+        /// The level of detail the heights come from, 0 to 7 [default: the coarsest whose vertices lie no farther
+        /// apart than the pixels, at most 7].
+        #[arg(long)]
+        level: Option<u32>,
+        /// tiff (32-bit float GeoTIFF) or png (16-bit grey).
+        #[arg(long, value_parser = RasterFormat::parse, default_value = "tiff")]
+        format: RasterFormat,
+        /// The file: .tif or .tiff for tiff, .png for png.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// The rivers as RFC 7946 GeoJSON: lines cut at the antimeridian, [lon, lat] (the drainage model: [lon, lat,
     /// bed height]) rounded to 1e-6 degrees, with width, length and order (Strahler order for the drainage
     /// model); the drainage model's lakes as polygons.

@@ -59,6 +59,29 @@ where
     })
 }
 
+/// Checks before any work that `path` can be a folder to write into: an existing folder, or a new one whose
+/// parent exists. `argument` names the option in the message.
+pub fn check_folder(argument: &str, path: &Path) -> Result<(), String> {
+    if path.exists() && !path.is_dir() {
+        return Err(format!(
+            "{argument} {} is a file; give a folder",
+            path.display()
+        ));
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !path.exists() && !parent.is_dir() {
+        return Err(format!(
+            "{argument} {}: the folder {} does not exist",
+            path.display(),
+            parent.display()
+        ));
+    }
+    Ok(())
+}
+
 /// Checks before any work that `path` can be written: its folder exists (or `create` makes it) and, for
 /// `png_only`, it names a PNG file. `argument` names the option in the message.
 pub fn check_output(argument: &str, path: &Path, png_only: bool) -> Result<(), String> {

@@ -152,9 +152,7 @@ mod tests {
     use super::*;
 
     fn at(lon: f64, lat: f64) -> DVec3 {
-        let (lon, lat) = (lon.to_radians(), lat.to_radians());
-        // Inverse of planet::lon_lat.
-        DVec3::new(lat.cos() * lon.cos(), lat.sin(), -lat.cos() * lon.sin())
+        crate::planet::direction_at(lon, lat)
     }
 
     #[test]

@@ -1,19 +1,19 @@
-//! What `riverplanet generate` writes: per-face 16-bit heightmaps with their layout, statistics, and an unfolded
-//! colour preview.
+//! The planet for other tools and for people (beyond the thesis): heightmaps (`heightmaps`, `raster`, with the
+//! rivers carved in by `carved`), rivers as GeoJSON (`geojson`, `drainage`), and here the unfolded colour
+//! preview and the land mask that `generate` writes.
 
-use std::{fs, path::Path};
-
-use image::{ImageBuffer, Luma, Rgb, RgbImage};
-use rayon::prelude::*;
+use image::{Rgb, RgbImage};
 use serde_json::json;
 
+pub mod carved;
 pub mod drainage;
 pub mod files;
 pub mod geojson;
+pub mod heightmaps;
+pub mod raster;
 
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},
-    heights::FaceLattice,
     Planet,
 };
 
@@ -21,70 +21,6 @@ use crate::planet::{
 pub enum ExportError {
     #[error("cannot write {path}: {message}")]
     Write { path: String, message: String },
-}
-
-fn write_err(path: &Path, e: impl std::fmt::Display) -> ExportError {
-    ExportError::Write {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    }
-}
-
-/// Writes `dir/faces/face{0..5}.png` (16-bit grey, one pixel per vertex of `lattice`'s level, its lowest to
-/// highest height mapped to 0..65535; pixel (i, j) is lattice point u = -1 + i step, v = -1 + j step) and
-/// `dir/faces/layout.json` (with the level and the height range).
-pub fn write_faces(lattice: &FaceLattice, level: u32, dir: &Path) -> Result<(), ExportError> {
-    let faces_dir = dir.join("faces");
-    fs::create_dir_all(&faces_dir).map_err(|e| write_err(&faces_dir, e))?;
-    let side = lattice.side() as u32;
-    let (lo, hi) = lattice
-        .data
-        .par_iter()
-        .fold(
-            || (f32::MAX, f32::MIN),
-            |(lo, hi), &h| (lo.min(h), hi.max(h)),
-        )
-        .reduce(|| (f32::MAX, f32::MIN), |a, b| (a.0.min(b.0), a.1.max(b.1)));
-    let scale = if hi > lo { 65535.0 / (hi - lo) } else { 0.0 };
-    (0..FACES).into_par_iter().try_for_each(|face| {
-        let image: ImageBuffer<Luma<u16>, Vec<u16>> = ImageBuffer::from_fn(side, side, |i, j| {
-            Luma([((lattice.get(face, i, j) - lo) * scale)
-                .round()
-                .clamp(0.0, 65535.0) as u16])
-        });
-        let path = faces_dir.join(format!("face{face}.png"));
-        files::write_atomically(&path, |temporary| {
-            let file = fs::File::create(temporary).map_err(|e| e.to_string())?;
-            let encoder = image::codecs::png::PngEncoder::new_with_quality(
-                std::io::BufWriter::new(file),
-                image::codecs::png::CompressionType::Fast,
-                image::codecs::png::FilterType::Sub,
-            );
-            image.write_with_encoder(encoder).map_err(|e| e.to_string())
-        })
-    })?;
-    let step = 2.0 / lattice.cells as f64;
-    let layout: Vec<_> = (0..FACES)
-        .map(|face| {
-            let (_, a, b) = FACE_AXES[face];
-            json!({
-                "face": face,
-                "origin": cube_point(face, -1.0, -1.0).to_array(),
-                "step_x": (a * step).to_array(),
-                "step_y": (b * step).to_array(),
-                "size": [side, side],
-            })
-        })
-        .collect();
-    let path = faces_dir.join("layout.json");
-    let text = serde_json::to_string_pretty(&json!({
-        "level": level,
-        "min_height": lo,
-        "max_height": hi,
-        "faces": layout,
-    }))
-    .map_err(|e| write_err(&path, e))?;
-    files::write_bytes(&path, text.as_bytes())
 }
 
 /// Terrain colour for a height (sea by depth, then sand, grass, rock, snow).

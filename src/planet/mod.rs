@@ -47,6 +47,12 @@ pub fn lon_lat(p: DVec3) -> (f64, f64) {
     )
 }
 
+/// The unit direction at a longitude and latitude in degrees: the inverse of [`lon_lat`].
+pub fn direction_at(lon: f64, lat: f64) -> DVec3 {
+    let (lon, lat) = (lon.to_radians(), lat.to_radians());
+    DVec3::new(lat.cos() * lon.cos(), lat.sin(), -lat.cos() * lon.sin())
+}
+
 /// Problems generating a planet.
 #[derive(Debug, thiserror::Error)]
 pub enum PlanetError {

@@ -1,0 +1,141 @@
+//! The planet's terrain at one level of detail with the rivers carved in, as the renderer draws it (beyond the
+//! thesis, for exports): every patch of the level gets the river kernel's texels from its samples (Sections
+//! 6.3-6.6, the CPU reference, which the GPU kernels equal bit for bit) and each vertex blends the kernel's river
+//! terrain into the base height by the lerp factor (Section 8.2, `mix(terrain, base, lerp)` in the vertex
+//! shaders). A vertex on a patch edge belongs to two patches (four at a corner, three at a cube corner), whose
+//! kernels measure distances in their own face planes: within a face they agree to f32 rounding, across a face
+//! edge they can differ by more than the basin depth where a river is near (on the default planet up to 0.15 at
+//! 14 % of the face-edge points of level 2; the renderer's skirts cover the step). The export writes the mean of
+//! every patch's value there, so that the faces meet without a step.
+
+use std::collections::HashMap;
+
+use glam::I64Vec3;
+use rayon::prelude::*;
+
+use crate::{
+    config::Config,
+    kernel::{cpu::compute_patch, KernelParams, PatchJob},
+    planet::{cube::PatchId, cube::FACES, detail, heights::FaceLattice, Planet},
+    river::{
+        network::RiverNetwork,
+        samples::{patch_samples, PatchFrame},
+    },
+};
+
+/// The finest level an export computes: level 7 holds 6 x 4097 x 4097 heights (403 MB of f32, about three times
+/// that while it is made).
+pub const MAX_EXPORT_LEVEL: u32 = 7;
+
+/// Terrain heights (above the sphere of the planet's radius, with the river beds) of every vertex of `level`, one
+/// lattice per face: point (i, j) of face f is the direction of cube point u = -1 + 2 i / cells, v = -1 + 2 j /
+/// cells ([`FaceLattice`]).
+pub fn carved_terrain(
+    planet: &Planet,
+    network: &RiverNetwork,
+    config: &Config,
+    level: u32,
+) -> FaceLattice {
+    let n = config.rendering.vertices;
+    let params = KernelParams::from_config(config);
+    let mut lattice = planet.face_lattice(level);
+    let count = 1u32 << level;
+    // Per lattice point on a patch edge, the sum and number of the values patches gave it.
+    let mut shared: HashMap<I64Vec3, (f32, u32)> = HashMap::new();
+    for face in 0..FACES {
+        let patches: Vec<PatchId> = (0..count * count)
+            .map(|k| PatchId {
+                face: face as u8,
+                level: level as u8,
+                x: k % count,
+                y: k / count,
+            })
+            .collect();
+        let carved: Vec<(PatchId, Vec<f32>)> = patches
+            .par_iter()
+            .map(|&patch| {
+                (
+                    patch,
+                    carve_patch(&lattice, patch, planet, network, n, &params),
+                )
+            })
+            .collect();
+        for (patch, heights) in carved {
+            let (x0, y0) = detail::origin(patch, n);
+            for (k, h) in heights.into_iter().enumerate() {
+                let (i, j) = (x0 as u32 + k as u32 % n, y0 as u32 + k as u32 / n);
+                let on_edge = [i % (n - 1), j % (n - 1)].contains(&0);
+                if on_edge {
+                    let entry = shared.entry(lattice.key(face, i, j)).or_insert((0.0, 0));
+                    *entry = (entry.0 + h, entry.1 + 1);
+                } else {
+                    let index = lattice.index(face, i, j);
+                    lattice.data[index] = h;
+                }
+            }
+        }
+    }
+    for face in 0..FACES {
+        for j in 0..=lattice.cells {
+            for i in 0..=lattice.cells {
+                if let Some(&(sum, count)) = shared.get(&lattice.key(face, i, j)) {
+                    let index = lattice.index(face, i, j);
+                    lattice.data[index] = sum / count as f32;
+                }
+            }
+        }
+    }
+    lattice
+}
+
+/// The heights of `patch`'s vertices, row by row: the base heights of `lattice` with the river kernel's terrain
+/// blended in where rivers reach the patch.
+fn carve_patch(
+    lattice: &FaceLattice,
+    patch: PatchId,
+    planet: &Planet,
+    network: &RiverNetwork,
+    n: u32,
+    params: &KernelParams,
+) -> Vec<f32> {
+    let frame = PatchFrame::new(patch, planet.radius, n);
+    let samples = patch_samples(network, &frame).samples;
+    let (x0, y0) = detail::origin(patch, n);
+    let base = |k: u32| lattice.get(patch.face as usize, x0 as u32 + k % n, y0 as u32 + k / n);
+    if samples.is_empty() {
+        return (0..n * n).map(base).collect();
+    }
+    let job = PatchJob {
+        spacing: frame.spacing() as f32,
+        samples: &samples,
+    };
+    compute_patch(&job, n, params)
+        .iter()
+        .zip(0..)
+        .map(|(t, k)| mix(t.terrain_height, base(k), t.lerp_factor))
+        .collect()
+}
+
+/// GLSL's `mix`, as the vertex shaders blend.
+fn mix(a: f32, b: f32, t: f32) -> f32 {
+    a * (1.0 - t) + b * t
+}
+
+/// The height of `lattice` in the direction `d`, bilinear between the four lattice points around it.
+pub fn height_towards(lattice: &FaceLattice, d: glam::DVec3) -> f32 {
+    let (face, u, v) = crate::planet::cube::face_of(d);
+    let cells = lattice.cells as f64;
+    let x = ((u + 1.0) * 0.5 * cells).clamp(0.0, cells);
+    let y = ((v + 1.0) * 0.5 * cells).clamp(0.0, cells);
+    let (i, j) = (
+        (x.floor() as u32).min(lattice.cells - 1),
+        (y.floor() as u32).min(lattice.cells - 1),
+    );
+    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
+    let row = |j| {
+        let a = lattice.get(face, i, j);
+        a + (lattice.get(face, i + 1, j) - a) * fx
+    };
+    let (a, b) = (row(j), row(j + 1));
+    a + (b - a) * fy
+}
