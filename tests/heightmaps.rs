@@ -1,6 +1,6 @@
-//! `riverplanet export faces` and `export equirect`: the files read back by a reader of their own (a TIFF reader
+//! `riverplanet export faces`, `export equirect` and `export region`: the files read back by a reader of their own (a TIFF reader
 //! written here from the TIFF 6.0 and GeoTIFF 1.1 specifications, not the `tiff` crate that writes them; PNGs
-//! through the `image` crate), their values checked against the library's carved heights, the river channels
+//! through the `image` crate, glTF through the `gltf` crate's importer), their values checked against the library's carved heights, the river channels
 //! found below the land at the rivers' own coordinates, and the faces agreeing across their seams.
 
 use std::{collections::HashMap, path::Path, process::Command};
@@ -259,7 +259,8 @@ fn height_exports_refuse_bad_arguments_before_any_work() {
     let file = dir.join("a-file");
     std::fs::write(&file, b"keep").unwrap();
     let png = dir.join("x.png");
-    let cases: [(Vec<&str>, &str); 5] = [
+    let glb = dir.join("x.glb");
+    let cases: [(Vec<&str>, &str); 9] = [
         (
             vec![
                 "export",
@@ -294,6 +295,38 @@ fn height_exports_refuse_bad_arguments_before_any_work() {
             vec!["export", "equirect", "--size", "1x1", "--out", "x.tif"],
             "both must be at least 2",
         ),
+        (
+            vec!["export", "region", "--bounds=10,0,5,5", "--out", "x.tif"],
+            "longitudes 10 and 5 must lie in [-180, 180], west below east",
+        ),
+        (
+            vec!["export", "region", "--bounds=0,-95,5,5", "--out", "x.tif"],
+            "latitudes -95 and 5 must lie in [-90, 90]",
+        ),
+        (
+            vec![
+                "export",
+                "region",
+                "--bounds=0,0,90,60",
+                "--level",
+                "12",
+                "--out",
+                "x.tif",
+            ],
+            "at most 16777216",
+        ),
+        (
+            vec![
+                "export",
+                "region",
+                "--bounds=0,0,5,5",
+                "--format",
+                "tiff",
+                "--out",
+                glb.to_str().unwrap(),
+            ],
+            "--format tiff writes .tif files",
+        ),
     ];
     for (args, message) in cases {
         let out = run(&args);
@@ -302,7 +335,7 @@ fn height_exports_refuse_bad_arguments_before_any_work() {
         assert!(stderr.contains(message), "{args:?}: {stderr}");
     }
     assert_eq!(std::fs::read(&file).unwrap(), b"keep");
-    assert!(!png.exists());
+    assert!(!png.exists() && !glb.exists());
     assert_eq!(
         std::fs::read_dir(&dir).unwrap().count(),
         1,
@@ -411,5 +444,76 @@ fn the_faces_hold_the_river_channels_below_their_banks() {
         carved_depth > base_depth + 0.02,
         "banks - bed: {carved_depth:.4} carved, {base_depth:.4} uncarved"
     );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A region as GeoTIFF and as glTF: the raster georeferenced to its bounds; the mesh opens in the `gltf` crate's
+/// importer with every accessor read, holds a terrain mesh over every sample and a water mesh, unit normals,
+/// indices in range, and its terrain vertices lie at the GeoTIFF's heights in the local frame docs/exports.md
+/// gives (origin on the sea-level sphere below the centre, +X east, +Y up, -Z north).
+#[test]
+fn a_region_exports_as_a_georeferenced_raster_and_as_a_gltf_mesh_at_the_same_heights() {
+    let dir = temp_dir("region");
+    let (tif, glb) = (dir.join("region.tif"), dir.join("region.glb"));
+    let bounds = "--bounds=-28,3,-23,8";
+    for (format, out) in [("tiff", &tif), ("glb", &glb)] {
+        succeed(&[
+            "export",
+            "region",
+            "--seed",
+            "1",
+            bounds,
+            "--level",
+            "6",
+            "--format",
+            format,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+    }
+    let raster = read_tiff(&tif);
+    let (width, height) = (raster.width as usize, raster.height as usize);
+    assert!(width > 50 && height > 50, "{width} x {height}");
+    let (dx, dy) = (5.0 / width as f64, 5.0 / height as f64);
+    assert_eq!(raster.tags[&33922], vec![0.0, 0.0, 0.0, -28.0, 8.0, 0.0]);
+    assert_eq!(raster.tags[&33550], vec![dx, dy, 0.0]);
+
+    let (document, buffers, _) = gltf::import_slice(std::fs::read(&glb).unwrap()).unwrap();
+    let meshes: Vec<gltf::Mesh> = document.meshes().collect();
+    let names: Vec<&str> = meshes.iter().map(|m| m.name().unwrap()).collect();
+    assert_eq!(names, ["terrain", "water"]);
+    let radius = 1024.0;
+    let up = direction_at(-25.5, 5.5);
+    let east = DVec3::Y.cross(up).normalize();
+    let north = up.cross(east);
+    for mesh in &meshes {
+        let primitive = mesh.primitives().next().unwrap();
+        let reader = primitive.reader(|b| Some(&buffers[b.index()]));
+        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+        let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
+        let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+        assert_eq!(positions.len(), width * height, "{}", mesh.name().unwrap());
+        assert_eq!(normals.len(), positions.len());
+        assert!(indices.len() % 3 == 0 && !indices.is_empty());
+        assert!(indices.iter().all(|&i| (i as usize) < positions.len()));
+        for n in &normals {
+            let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            assert!((length - 1.0).abs() < 1e-4, "normal {n:?}");
+            assert!(n[1] > 0.0, "a normal points down: {n:?}");
+        }
+        if mesh.name() == Some("terrain") {
+            assert_eq!(indices.len(), 6 * (width - 1) * (height - 1));
+            for (k, p) in positions.iter().enumerate().step_by(13) {
+                let world =
+                    up * radius + east * p[0] as f64 + up * p[1] as f64 - north * p[2] as f64;
+                let h = world.length() - radius;
+                let expected = raster.values[k] as f64;
+                assert!(
+                    (h - expected).abs() < 1e-3,
+                    "vertex {k}: {h} above the sphere, the GeoTIFF says {expected}"
+                );
+            }
+        }
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -6,12 +6,14 @@ use riverplanet::{
     export::{
         self,
         carved::{carved_terrain, MAX_EXPORT_LEVEL},
-        heightmaps::{planet_metadata, write_equirect, write_faces},
+        heightmaps::{planet_metadata, write_equirect, write_faces, write_georeferenced},
+        mesh::write_glb,
+        region::{sample_region, Region},
     },
     world::World,
 };
 
-use super::ExportCommand;
+use super::{ExportCommand, RegionFormat};
 use crate::{load_config, planet_seed, usage};
 
 /// The finest level `export rivers` refines the thesis's river pieces to (as `hull-levels`' range).
@@ -89,8 +91,82 @@ pub fn export(what: ExportCommand) -> anyhow::Result<()> {
             );
             Ok(())
         }
+        ExportCommand::Region {
+            planet,
+            bounds,
+            level,
+            format,
+            out,
+        } => export_region(planet, bounds, level, format, &out),
         ExportCommand::Rivers { planet, level, out } => export_rivers(planet, level, &out),
     }
+}
+
+/// The finest level `export region` samples: patches are made only where the window is, down to any level the
+/// renderer reaches on config/earth.xml's scale of a few metres.
+const MAX_REGION_LEVEL: u32 = 20;
+
+fn export_region(
+    planet: super::PlanetArgs,
+    bounds: [f64; 4],
+    level: u32,
+    format: RegionFormat,
+    out: &Path,
+) -> anyhow::Result<()> {
+    if level > MAX_REGION_LEVEL {
+        return Err(usage(format!(
+            "--level {level} must be in [0, {MAX_REGION_LEVEL}]"
+        )));
+    }
+    let region = Region::new(bounds, level).map_err(usage)?;
+    export::files::check_output("--out", out, false).map_err(usage)?;
+    let named = match format {
+        RegionFormat::Raster(raster) => raster.names(out),
+        RegionFormat::Glb => out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb")),
+    };
+    if !named {
+        let (name, extension) = match format {
+            RegionFormat::Raster(raster) => (raster.name(), raster.extension()),
+            RegionFormat::Glb => ("glb", "glb"),
+        };
+        return Err(usage(format!(
+            "--out {}: --format {name} writes .{extension} files",
+            out.display()
+        )));
+    }
+    let (config, _) = load_config(planet.config.as_deref())?;
+    let seed = planet_seed(planet.seed, &config);
+    let world = World::build(&config, seed)?;
+    let surface = sample_region(&world.planet, &world.network, &config, level, &region);
+    let metadata = planet_metadata(&world.planet, seed, level, true);
+    let (width, height) = region.size;
+    match format {
+        RegionFormat::Raster(raster) => {
+            let geo = region.georeference(world.planet.radius);
+            write_georeferenced(out, region.size, &surface.terrain, raster, &metadata, &geo)?;
+            println!(
+                "{}: {width} x {height} samples from level {level}; metadata in {}",
+                out.display(),
+                out.with_extension("json").display()
+            );
+        }
+        RegionFormat::Glb => {
+            let (terrain, water) = write_glb(
+                out,
+                &region,
+                &surface,
+                (world.planet.radius, world.planet.sea_level),
+                &metadata,
+            )?;
+            println!(
+                "{}: {width} x {height} vertices from level {level}, {terrain} terrain and {water} water triangles",
+                out.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 fn check_level(level: u32) -> anyhow::Result<()> {

@@ -268,6 +268,25 @@ pub enum ExportCommand {
         #[arg(long)]
         out: PathBuf,
     },
+    /// A longitude-latitude window at one level of detail: the terrain with the rivers carved in as a GeoTIFF or
+    /// 16-bit PNG (metadata beside it, .json), or the terrain and the water surface as a binary glTF mesh with
+    /// normals in a local east-up-south frame (Blender: File > Import > glTF 2.0).
+    Region {
+        #[command(flatten)]
+        planet: PlanetArgs,
+        /// WEST,SOUTH,EAST,NORTH in degrees (west below east, south below north).
+        #[arg(long, value_parser = parse_bounds, allow_hyphen_values = true)]
+        bounds: [f64; 4],
+        /// Level of detail, 0 to 20: samples about one vertex spacing of that level apart.
+        #[arg(long, default_value_t = 6)]
+        level: u32,
+        /// tiff (32-bit float GeoTIFF), png (16-bit grey) or glb (mesh).
+        #[arg(long, value_parser = RegionFormat::parse, default_value = "tiff")]
+        format: RegionFormat,
+        /// The file: .tif or .tiff, .png, or .glb, as --format says.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// The rivers as RFC 7946 GeoJSON: lines cut at the antimeridian, [lon, lat] (the drainage model: [lon, lat,
     /// bed height]) rounded to 1e-6 degrees, with width, length and order (Strahler order for the drainage
     /// model); the drainage model's lakes as polygons.
@@ -282,6 +301,24 @@ pub enum ExportCommand {
         #[arg(long)]
         out: PathBuf,
     },
+}
+
+/// What `export region` writes.
+#[derive(Clone, Copy, Debug)]
+pub enum RegionFormat {
+    Raster(RasterFormat),
+    Glb,
+}
+
+impl RegionFormat {
+    fn parse(text: &str) -> Result<Self, String> {
+        match text {
+            "glb" => Ok(Self::Glb),
+            _ => RasterFormat::parse(text)
+                .map(Self::Raster)
+                .map_err(|_| format!("'{text}' is not a region format: tiff, png or glb")),
+        }
+    }
 }
 
 /// The planet a benchmark runs on (seed 1 unless given, so runs compare).
@@ -453,6 +490,21 @@ fn parse_vec3(text: &str) -> Result<glam::DVec3, String> {
         [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok(glam::DVec3::new(*x, *y, *z)),
         _ => Err(format!(
             "'{text}' is not three comma-separated numbers (e.g. 0,1200,3400)"
+        )),
+    }
+}
+
+/// WEST,SOUTH,EAST,NORTH: four finite numbers (their ranges are checked with the level, `Region::new`).
+fn parse_bounds(text: &str) -> Result<[f64; 4], String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{text}' is not WEST,SOUTH,EAST,NORTH in degrees"))?;
+    match values[..] {
+        [w, s, e, n] if values.iter().all(|v| v.is_finite()) => Ok([w, s, e, n]),
+        _ => Err(format!(
+            "'{text}' is not WEST,SOUTH,EAST,NORTH: four finite numbers in degrees"
         )),
     }
 }

@@ -51,18 +51,17 @@ pub fn carved_terrain(
                 y: k / count,
             })
             .collect();
-        let carved: Vec<(PatchId, Vec<f32>)> = patches
+        let carved: Vec<CarvedPatch> = patches
             .par_iter()
             .map(|&patch| {
-                (
-                    patch,
-                    carve_patch(&lattice, patch, planet, network, n, &params),
-                )
+                let (x0, y0) = detail::origin(patch, n);
+                let base = |i: u32, j: u32| lattice.get(face, x0 as u32 + i, y0 as u32 + j);
+                carve_patch(patch, base, planet, network, n, &params)
             })
             .collect();
-        for (patch, heights) in carved {
+        for CarvedPatch { patch, terrain, .. } in carved {
             let (x0, y0) = detail::origin(patch, n);
-            for (k, h) in heights.into_iter().enumerate() {
+            for (k, h) in terrain.into_iter().enumerate() {
                 let (i, j) = (x0 as u32 + k as u32 % n, y0 as u32 + k as u32 / n);
                 let on_edge = [i % (n - 1), j % (n - 1)].contains(&0);
                 if on_edge {
@@ -88,31 +87,77 @@ pub fn carved_terrain(
     lattice
 }
 
-/// The heights of `patch`'s vertices, row by row: the base heights of `lattice` with the river kernel's terrain
-/// blended in where rivers reach the patch.
-fn carve_patch(
-    lattice: &FaceLattice,
+/// One patch's surface as the renderer draws it, per vertex row by row: the terrain height (river beds carved in),
+/// the water height (the river's water, at least sea level), as `surfaceAt` in glsl/terrain_vertex.glsl, and how
+/// far inside a river's basin the vertex lies (half width - |signed distance|; positive inside, as the geometry
+/// shader's test).
+pub struct CarvedPatch {
+    pub patch: PatchId,
+    pub terrain: Vec<f32>,
+    pub water: Vec<f32>,
+    pub basin: Vec<f32>,
+}
+
+/// `patch`'s surface from its base height at vertex (i, j), `base`, and the river kernel where rivers reach it.
+pub fn carve_patch(
     patch: PatchId,
+    base: impl Fn(u32, u32) -> f32,
     planet: &Planet,
     network: &RiverNetwork,
     n: u32,
     params: &KernelParams,
-) -> Vec<f32> {
+) -> CarvedPatch {
     let frame = PatchFrame::new(patch, planet.radius, n);
     let samples = patch_samples(network, &frame).samples;
-    let (x0, y0) = detail::origin(patch, n);
-    let base = |k: u32| lattice.get(patch.face as usize, x0 as u32 + k % n, y0 as u32 + k / n);
+    let base_at = |k: u32| base(k % n, k / n);
     if samples.is_empty() {
-        return (0..n * n).map(base).collect();
+        return CarvedPatch {
+            patch,
+            terrain: (0..n * n).map(base_at).collect(),
+            water: vec![planet.sea_level; (n * n) as usize],
+            basin: vec![-params.influence_distance; (n * n) as usize],
+        };
     }
     let job = PatchJob {
         spacing: frame.spacing() as f32,
         samples: &samples,
     };
-    compute_patch(&job, n, params)
-        .iter()
-        .zip(0..)
-        .map(|(t, k)| mix(t.terrain_height, base(k), t.lerp_factor))
+    let texels = compute_patch(&job, n, params);
+    CarvedPatch {
+        patch,
+        terrain: texels
+            .iter()
+            .zip(0..)
+            .map(|(t, k)| mix(t.terrain_height, base_at(k), t.lerp_factor))
+            .collect(),
+        water: texels
+            .iter()
+            .map(|t| t.water_height.max(planet.sea_level))
+            .collect(),
+        basin: texels
+            .iter()
+            .map(|t| t.river_width - t.min_distance.abs())
+            .collect(),
+    }
+}
+
+/// The surfaces of `patches` (all of one level), in parallel, each patch's base heights refined on the CPU as the
+/// renderer refines them on the GPU ([`Planet::patch_heights`]).
+pub fn carve_patches(
+    patches: &[PatchId],
+    planet: &Planet,
+    network: &RiverNetwork,
+    config: &Config,
+) -> HashMap<PatchId, CarvedPatch> {
+    let n = config.rendering.vertices;
+    let params = KernelParams::from_config(config);
+    patches
+        .par_iter()
+        .map(|&patch| {
+            let heights = planet.patch_heights(patch);
+            let base = |i: u32, j: u32| heights.get(i as i64, j as i64);
+            (patch, carve_patch(patch, base, planet, network, n, &params))
+        })
         .collect()
 }
 

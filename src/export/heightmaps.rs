@@ -11,11 +11,11 @@ use super::{
     carved::height_towards,
     files,
     raster::{height_range, write_raster, Georeference, Raster, RasterFormat},
+    region::Region,
     ExportError,
 };
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},
-    direction_at,
     heights::FaceLattice,
     Planet,
 };
@@ -102,33 +102,44 @@ pub fn write_equirect(
     metadata: &Value,
     radius: f64,
 ) -> Result<Value, ExportError> {
-    let degrees_per_pixel = (360.0 / width as f64, 180.0 / height as f64);
+    let world = Region {
+        west: -180.0,
+        south: -90.0,
+        east: 180.0,
+        north: 90.0,
+        size: (width, height),
+    };
     let heights: Vec<f32> = (0..height * width)
         .into_par_iter()
-        .map(|k| {
-            let (x, y) = (k % width, k / width);
-            let lon = -180.0 + (x as f64 + 0.5) * degrees_per_pixel.0;
-            let lat = 90.0 - (y as f64 + 0.5) * degrees_per_pixel.1;
-            height_towards(lattice, direction_at(lon, lat))
-        })
+        .map(|k| height_towards(lattice, world.direction(k % width, k / width)))
         .collect();
+    let geo = world.georeference(radius);
+    write_georeferenced(path, (width, height), &heights, format, metadata, &geo)
+}
+
+/// Writes a longitude-latitude raster (row 0 in the north) with its georeference, and its metadata to `path`
+/// with extension `.json`. Returns the metadata.
+pub fn write_georeferenced(
+    path: &Path,
+    (width, height): (u32, u32),
+    heights: &[f32],
+    format: RasterFormat,
+    metadata: &Value,
+    geo: &Georeference,
+) -> Result<Value, ExportError> {
     let raster = Raster {
         width,
         height,
-        heights: &heights,
-        range: height_range(&heights),
+        heights,
+        range: height_range(heights),
     };
-    let geo = Georeference {
-        west: -180.0,
-        north: 90.0,
-        degrees_per_pixel,
-        radius,
-    };
-    let mut metadata = write_raster(path, &raster, format, metadata, Some(&geo))?;
-    metadata["projection"] = json!(
-        "equirectangular: longitude -180..180 left to right (east positive, from +X towards -Z), \
-         latitude 90..-90 top to bottom (north: +Y)"
-    );
+    let mut metadata = write_raster(path, &raster, format, metadata, Some(geo))?;
+    let (dx, dy) = geo.degrees_per_pixel;
+    metadata["projection"] = json!(format!(
+        "equirectangular: pixel (x, y) covers longitudes {} + x {dx} onwards (east positive, from +X towards -Z) \
+         and latitudes {} - y {dy} downwards (north: +Y)",
+        geo.west, geo.north
+    ));
     let text = serde_json::to_string_pretty(&metadata).expect("JSON values serialise");
     files::write_bytes(&path.with_extension("json"), text.as_bytes())?;
     Ok(metadata)

@@ -10,7 +10,9 @@ pub mod drainage;
 pub mod files;
 pub mod geojson;
 pub mod heightmaps;
+pub mod mesh;
 pub mod raster;
+pub mod region;
 
 use crate::planet::{
     cube::{cube_point, FACES, FACE_AXES},

@@ -1,0 +1,152 @@
+//! `riverplanet export region` (beyond the thesis): a longitude-latitude window of the planet at one level of
+//! detail, sampled at pixel centres from the carved patches of that level ([`super::carved`]) that it touches,
+//! as a georeferenced raster or as a mesh ([`super::mesh`]).
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::{
+    carved::{carve_patches, CarvedPatch},
+    raster::Georeference,
+};
+use crate::{
+    config::Config,
+    planet::{
+        cube::{face_of_on, PatchId},
+        direction_at, Planet,
+    },
+    river::network::RiverNetwork,
+};
+
+/// The most pixels (or mesh vertices) a region may have: 16 M (64 MB per f32 layer).
+pub const MAX_REGION_PIXELS: u64 = 1 << 24;
+
+/// A window west..east, south..north (degrees) split into `size` pixels of equal angle, sampled at their centres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    pub west: f64,
+    pub south: f64,
+    pub east: f64,
+    pub north: f64,
+    pub size: (u32, u32),
+}
+
+impl Region {
+    /// The window `bounds` (west, south, east, north in degrees) at about the vertex spacing of `level`: pixels
+    /// as tall as the lattice's spacing at a face's centre, and as wide as that on the ground at the window's
+    /// middle latitude. Errors name what is wrong.
+    pub fn new([west, south, east, north]: [f64; 4], level: u32) -> Result<Self, String> {
+        if !(-180.0..=180.0).contains(&west) || !(-180.0..=180.0).contains(&east) || west >= east {
+            return Err(format!(
+                "--bounds: longitudes {west} and {east} must lie in [-180, 180], west below east"
+            ));
+        }
+        if !(-90.0..=90.0).contains(&south) || !(-90.0..=90.0).contains(&north) || south >= north {
+            return Err(format!(
+                "--bounds: latitudes {south} and {north} must lie in [-90, 90], south below north"
+            ));
+        }
+        let spacing = 90.0 / (32u64 << level) as f64;
+        let middle = (0.5 * (south + north)).to_radians().cos().max(0.05);
+        let columns = ((east - west) * middle / spacing).round().max(2.0);
+        let rows = ((north - south) / spacing).round().max(2.0);
+        if columns * rows > MAX_REGION_PIXELS as f64 {
+            return Err(format!(
+                "--bounds and --level {level}: {columns} x {rows} samples; at most {MAX_REGION_PIXELS} \
+                 (a smaller window or a coarser level)"
+            ));
+        }
+        Ok(Self {
+            west,
+            south,
+            east,
+            north,
+            size: (columns as u32, rows as u32),
+        })
+    }
+
+    /// Degrees per pixel along longitude and latitude.
+    pub fn degrees_per_pixel(&self) -> (f64, f64) {
+        (
+            (self.east - self.west) / self.size.0 as f64,
+            (self.north - self.south) / self.size.1 as f64,
+        )
+    }
+
+    /// The unit direction at the centre of pixel (x, y), row 0 in the north.
+    pub fn direction(&self, x: u32, y: u32) -> DVec3 {
+        let (dx, dy) = self.degrees_per_pixel();
+        direction_at(
+            self.west + (x as f64 + 0.5) * dx,
+            self.north - (y as f64 + 0.5) * dy,
+        )
+    }
+
+    pub fn georeference(&self, radius: f64) -> Georeference {
+        Georeference {
+            west: self.west,
+            north: self.north,
+            degrees_per_pixel: self.degrees_per_pixel(),
+            radius,
+        }
+    }
+}
+
+/// A region's surface, row by row from the north-west: terrain heights (river beds carved in), water heights, and
+/// how far inside a river's basin each sample lies ([`CarvedPatch::basin`]).
+pub struct RegionSurface {
+    pub terrain: Vec<f32>,
+    pub water: Vec<f32>,
+    pub basin: Vec<f32>,
+}
+
+/// Samples `region` from the carved patches of `level` that contain its pixels' centres, bilinear between each
+/// patch's vertices. A pixel on a face edge reads one face's patch (they can differ there; docs/exports.md).
+pub fn sample_region(
+    planet: &Planet,
+    network: &RiverNetwork,
+    config: &Config,
+    level: u32,
+    region: &Region,
+) -> RegionSurface {
+    let (width, height) = region.size;
+    let pixels: Vec<(DVec3, PatchId)> = (0..width * height)
+        .into_par_iter()
+        .map(|k| {
+            let d = region.direction(k % width, k / width);
+            (d, PatchId::containing(d, level as u8))
+        })
+        .collect();
+    let mut patches: Vec<PatchId> = pixels.iter().map(|(_, p)| *p).collect();
+    patches.sort_unstable();
+    patches.dedup();
+    let carved = carve_patches(&patches, planet, network, config);
+    let n = config.rendering.vertices;
+    let sample = |layer: fn(&CarvedPatch) -> &[f32]| -> Vec<f32> {
+        pixels
+            .par_iter()
+            .map(|(d, patch)| bilinear(&carved[patch], layer(&carved[patch]), *d, n))
+            .collect()
+    };
+    RegionSurface {
+        terrain: sample(|c| &c.terrain),
+        water: sample(|c| &c.water),
+        basin: sample(|c| &c.basin),
+    }
+}
+
+/// `values` (one per vertex of `surface`'s patch) at direction `d` within the patch.
+fn bilinear(surface: &CarvedPatch, values: &[f32], d: DVec3, n: u32) -> f32 {
+    let patch = surface.patch;
+    let (_, u, v) = face_of_on(patch.face as usize, d);
+    let (u0, v0) = patch.origin();
+    let cells = (n - 1) as f64;
+    let s = ((u - u0) / patch.size() * cells).clamp(0.0, cells);
+    let t = ((v - v0) / patch.size() * cells).clamp(0.0, cells);
+    let (i, j) = ((s as u32).min(n - 2), (t as u32).min(n - 2));
+    let (fs, ft) = ((s - i as f64) as f32, (t - j as f64) as f32);
+    let at = |i: u32, j: u32| values[(j * n + i) as usize];
+    let bottom = at(i, j) + (at(i + 1, j) - at(i, j)) * fs;
+    let top = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * fs;
+    bottom + (top - bottom) * ft
+}
