@@ -672,3 +672,101 @@ fn report_and_plot_name_a_report_of_the_wrong_command() {
     assert_refused(&run, 2, &["kernel.json", "`bench flight`"]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A camera path (the viewer's `--record` or bookmarks) replays: `render --path --path-frame K` draws the same
+/// image as `render` with that frame's eye, direction, up and the viewer's field of view; a frame beyond the
+/// path is refused; `bench flight --path` flies one frame per recorded frame.
+#[test]
+fn a_recorded_camera_path_replays_in_render_and_bench_flight() {
+    let dir = temp_dir("camera-path");
+    let path = dir.join("path.json");
+    let frames: Vec<serde_json::Value> = [3400.0, 2600.0, 1900.0]
+        .iter()
+        .enumerate()
+        .map(|(k, z)| {
+            serde_json::json!({
+                "time": k as f64 * 0.5, "position": [0.0, 300.0, z], "forward": [0.0, -0.1, -1.0],
+                "up": [0.0, 1.0, 0.0], "altitude": z - 1024.0,
+            })
+        })
+        .collect();
+    std::fs::write(
+        &path,
+        serde_json::json!({"seed": 1, "frames": frames}).to_string(),
+    )
+    .unwrap();
+    let render = |args: &[&str], out: &std::path::Path| {
+        riverplanet()
+            .args(["render", "--seed", "1", "--size", "96x54", "--out"])
+            .arg(out)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let replayed = dir.join("replayed.png");
+    let path_arg = path.to_str().unwrap();
+    let run = render(&["--path", path_arg, "--path-frame", "2"], &replayed);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let direct = dir.join("direct.png");
+    let run = render(
+        &[
+            "--eye=0,300,2600",
+            "--look-at=0,299.9,2599",
+            "--up=0,1,0",
+            "--fov",
+            "60",
+        ],
+        &direct,
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let (a, b) = (
+        image::open(&replayed).unwrap().to_rgba8(),
+        image::open(&direct).unwrap().to_rgba8(),
+    );
+    let differing = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 2))
+        .count();
+    assert!(differing < 20, "{differing} pixels differ");
+    let beyond = render(
+        &["--path", path_arg, "--path-frame", "4"],
+        &dir.join("no.png"),
+    );
+    assert_refused(&beyond, 2, &["--path-frame 4 must be in [1, 3]"]);
+    assert!(!dir.join("no.png").exists());
+
+    let json = dir.join("flight.json");
+    let run = riverplanet()
+        .args([
+            "bench",
+            "flight",
+            "--path",
+            path_arg,
+            "--size",
+            "96x54",
+            "--summary-only",
+        ])
+        .args(["--no-kernel-comparison", "--no-water-comparison", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["summary"]["frames"], 3);
+    assert_eq!(report["recorded_path"], true);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -89,3 +89,280 @@ fn viewer_runs_60_frames_under_xvfb_and_its_screenshot_sidecar_renders_the_same_
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// An X server of the test's own (Xvfb on a free display), killed when dropped.
+struct Xvfb {
+    display: String,
+    server: std::process::Child,
+}
+
+impl Xvfb {
+    fn start() -> Option<Self> {
+        for number in 40 + std::process::id() % 200..400 {
+            if std::path::Path::new(&format!("/tmp/.X11-unix/X{number}")).exists() {
+                continue;
+            }
+            let server = Command::new("Xvfb")
+                .args([
+                    &format!(":{number}"),
+                    "-screen",
+                    "0",
+                    "640x480x24",
+                    "-nolisten",
+                    "tcp",
+                ])
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .ok()?;
+            let display = format!(":{number}");
+            for _ in 0..100 {
+                if std::path::Path::new(&format!("/tmp/.X11-unix/X{number}")).exists() {
+                    return Some(Self { display, server });
+                }
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            return None;
+        }
+        None
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.server.kill();
+        let _ = self.server.wait();
+    }
+}
+
+/// Synthetic input through the X server's XTEST extension, as a user's mouse and keyboard would send it.
+struct Input {
+    conn: x11rb::rust_connection::RustConnection,
+    root: u32,
+}
+
+impl Input {
+    fn connect(display: &str) -> Self {
+        use x11rb::connection::Connection;
+        let (conn, screen) =
+            x11rb::rust_connection::RustConnection::connect(Some(display)).unwrap();
+        let root = conn.setup().roots[screen].root;
+        Self { conn, root }
+    }
+
+    fn fake(&self, kind: u8, detail: u8, (x, y): (i16, i16)) {
+        use x11rb::{connection::Connection, protocol::xtest::ConnectionExt};
+        self.conn
+            .xtest_fake_input(kind, detail, 0, self.root, x, y, 0)
+            .unwrap();
+        self.conn.flush().unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(30));
+    }
+
+    fn move_to(&self, x: i16, y: i16) {
+        self.fake(x11rb::protocol::xproto::MOTION_NOTIFY_EVENT, 0, (x, y));
+    }
+
+    fn button(&self, button: u8, down: bool) {
+        use x11rb::protocol::xproto::{BUTTON_PRESS_EVENT, BUTTON_RELEASE_EVENT};
+        let kind = if down {
+            BUTTON_PRESS_EVENT
+        } else {
+            BUTTON_RELEASE_EVENT
+        };
+        self.fake(kind, button, (0, 0));
+    }
+
+    /// The keycode of a keysym (X11 keysyms of letters are their lower-case ASCII codes).
+    fn keycode(&self, keysym: u32) -> u8 {
+        use x11rb::{connection::Connection, protocol::xproto::ConnectionExt};
+        let setup = self.conn.setup();
+        let (min, max) = (setup.min_keycode, setup.max_keycode);
+        let map = self
+            .conn
+            .get_keyboard_mapping(min, max - min + 1)
+            .unwrap()
+            .reply()
+            .unwrap();
+        let per = map.keysyms_per_keycode as usize;
+        let index = map.keysyms.iter().position(|&k| k == keysym).unwrap();
+        min + (index / per) as u8
+    }
+
+    fn key(&self, keysym: u32, down: bool) {
+        use x11rb::protocol::xproto::{KEY_PRESS_EVENT, KEY_RELEASE_EVENT};
+        let kind = if down {
+            KEY_PRESS_EVENT
+        } else {
+            KEY_RELEASE_EVENT
+        };
+        self.fake(kind, self.keycode(keysym), (0, 0));
+    }
+
+    /// The window mapped on the screen, if one is; it gets the keyboard focus (no window manager gives it).
+    fn shown_window(&self) -> Option<u32> {
+        use x11rb::{
+            connection::Connection,
+            protocol::xproto::{ConnectionExt, InputFocus, MapState},
+        };
+        let tree = self.conn.query_tree(self.root).unwrap().reply().unwrap();
+        let window = tree.children.into_iter().find(|&w| {
+            self.conn
+                .get_window_attributes(w)
+                .ok()
+                .and_then(|c| c.reply().ok())
+                .is_some_and(|a| a.map_state == MapState::VIEWABLE)
+        })?;
+        self.conn
+            .set_input_focus(InputFocus::POINTER_ROOT, window, x11rb::CURRENT_TIME)
+            .unwrap();
+        self.conn.flush().unwrap();
+        Some(window)
+    }
+}
+
+const XK_Q: u32 = 0x71;
+const XK_H: u32 = 0x68;
+const XK_SHIFT_L: u32 = 0xffe1;
+const XK_ESCAPE: u32 = 0xff1b;
+
+/// The viewer driven by synthetic mouse and keyboard input under Xvfb: an orbit drag turns the view, ten wheel
+/// lines zoom towards the ground, Shift+Q held descends until the camera meets the surface, H returns home,
+/// Escape quits. The recorded camera path (`--record`) shows every frame at least 0.3 above the drawn surface
+/// below the camera, recomputed here (`render::ground`), the descent reaching it, and the last frame at home.
+#[test]
+fn the_viewer_follows_synthetic_input_and_its_camera_stays_above_the_surface() {
+    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
+    let Some(xvfb) = Xvfb::start() else {
+        assert!(
+            !required,
+            "RIVERPLANET_REQUIRE_GPU=1 but Xvfb does not start (tools/setup installs xvfb)"
+        );
+        eprintln!("skipping: Xvfb does not start");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("riverplanet-input-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = dir.join("small.xml");
+    std::fs::write(
+        &config,
+        "<planet><planet-attributes><base-resolution>65</base-resolution><master-seed>3</master-seed>\
+         </planet-attributes><rendering-attributes><max-level-of-detail>4</max-level-of-detail>\
+         </rendering-attributes></planet>",
+    )
+    .unwrap();
+    let record = dir.join("path.json");
+    let mut viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
+        .args(["view", "--size", "320x240", "--config"])
+        .arg(&config)
+        .arg("--record")
+        .arg(&record)
+        .arg("--screenshots")
+        .arg(&dir)
+        .env("DISPLAY", &xvfb.display)
+        .env("RIVERPLANET_VALIDATION", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let input = Input::connect(&xvfb.display);
+    let started = std::time::Instant::now();
+    while input.shown_window().is_none() {
+        if let Ok(Some(status)) = viewer.try_wait() {
+            let output = viewer.wait_with_output().unwrap();
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            if !required && stderr.contains("no usable Vulkan") {
+                eprintln!("skipping: {stderr}");
+                return;
+            }
+            panic!("the viewer ended ({status}) before showing a window: {stderr}");
+        }
+        assert!(started.elapsed().as_secs() < 60, "no window after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let pause = |ms| std::thread::sleep(std::time::Duration::from_millis(ms));
+    pause(1500);
+    // Focus again now that the viewer listens (no window manager gives it).
+    input.shown_window();
+    // Orbit drag across the window.
+    input.move_to(100, 120);
+    input.button(1, true);
+    for step in 1..=10 {
+        input.move_to(100 + 12 * step, 120);
+    }
+    input.button(1, false);
+    pause(500);
+    // Ten wheel lines towards the ground (button 4: wheel up).
+    for _ in 0..10 {
+        input.button(4, true);
+        input.button(4, false);
+    }
+    pause(500);
+    // Descend fast until the ground stops the camera.
+    input.key(XK_SHIFT_L, true);
+    input.key(XK_Q, true);
+    pause(5000);
+    input.key(XK_Q, false);
+    input.key(XK_SHIFT_L, false);
+    pause(500);
+    input.key(XK_H, true);
+    input.key(XK_H, false);
+    pause(1000);
+    input.key(XK_ESCAPE, true);
+    input.key(XK_ESCAPE, false);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while viewer.try_wait().unwrap().is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = viewer.kill();
+            let output = viewer.wait_with_output().unwrap();
+            panic!(
+                "the viewer did not close on Escape: {}{}",
+                String::from_utf8_lossy(&output.stdout),
+                String::from_utf8_lossy(&output.stderr)
+            );
+        }
+        pause(100);
+    }
+    let output = viewer.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "viewer failed: {stderr}");
+
+    let path = riverplanet::runtime::camera_path::CameraPath::load(&record).unwrap();
+    let frames = &path.frames;
+    assert!(frames.len() > 20, "only {} frames recorded", frames.len());
+    let config = riverplanet::config::Config::load(&config).unwrap();
+    let world = riverplanet::world::World::build(&config, 3).unwrap();
+    let mut ground = riverplanet::render::ground::Ground::new(&world);
+    let radius = world.planet.radius;
+    let position = |k: usize| glam::DVec3::from_array(frames[k].position);
+    let mut lowest = f64::MAX;
+    for (k, frame) in frames.iter().enumerate() {
+        let p = position(k);
+        let above = p.length() - radius - ground.height_below(p, &world);
+        assert!(above >= 0.3 - 1e-6, "frame {k}: {above} above the surface");
+        assert!(
+            (above - frame.altitude).abs() < 1e-6,
+            "frame {k}: recorded altitude"
+        );
+        lowest = lowest.min(above);
+    }
+    let turned = (0..frames.len())
+        .map(|k| position(k).angle_between(position(0)))
+        .fold(0.0, f64::max);
+    let home = frames[0].altitude;
+    eprintln!(
+        "{} frames: turned by up to {turned:.3} rad, lowest {lowest:.3} above the surface (home {home:.1})",
+        frames.len()
+    );
+    assert!(
+        turned > 0.05,
+        "the drag did not turn the view ({turned} rad)"
+    );
+    assert!(
+        lowest < 1.0,
+        "the descent stopped {lowest} above the surface"
+    );
+    let last = frames.last().unwrap();
+    assert_eq!(last.position, frames[0].position, "H did not return home");
+    assert_eq!(last.forward, frames[0].forward);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -107,6 +107,8 @@ pub struct FlightReport {
     pub threads: Threads,
     pub stress: bool,
     pub descent: bool,
+    /// Whether the flight replayed a recorded camera path.
+    pub recorded_path: bool,
     pub morphing: bool,
     pub parent_reuse: bool,
     pub frames_in_flight: usize,
@@ -139,6 +141,8 @@ pub struct FlightOptions {
     pub compare_water_modes: bool,
     /// Fly the descent to the ground instead of the thesis's path.
     pub descent: bool,
+    /// Replay a recorded camera path instead (`frames` of it).
+    pub path: Option<crate::runtime::camera_path::CameraPath>,
     /// Where to write the images of frames the hole check fails on (`holes-FRAME.png`).
     pub hole_images: Option<std::path::PathBuf>,
     /// Nearest-point selection with morphing (`false`: the thesis's Eq. 6.1 and instant switching).
@@ -198,7 +202,9 @@ fn fly(
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
     let aspect = w as f64 / h as f64;
-    let flight = if options.descent {
+    let flight = if let Some(path) = &options.path {
+        Flight::recorded(world, path.clone(), aspect)
+    } else if options.descent {
         Flight::descent(world, options.frames, aspect).ok_or_else(|| {
             GpuError::Invalid("the descent needs a river, and this planet has none".into())
         })?
@@ -476,6 +482,7 @@ pub fn flight_bench(
         threads: Threads::current(),
         stress: options.stress,
         descent: options.descent,
+        recorded_path: options.path.is_some(),
         morphing: options.morphing,
         atmosphere: options.atmosphere,
         vertex_cache: options.vertex_cache,

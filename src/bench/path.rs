@@ -6,11 +6,17 @@
 
 use glam::DVec3;
 
-use crate::{render::presets::GROUND_EYE_HEIGHT, runtime::camera::Camera, world::World};
+use crate::{
+    render::presets::GROUND_EYE_HEIGHT,
+    runtime::{camera::Camera, camera_path::CameraPath},
+    world::World,
+};
 
 /// A flight of `frames` frames over `world`.
 #[derive(Clone, Debug)]
 pub struct Flight {
+    /// A recorded camera path replayed frame by frame instead of the scripted cameras.
+    recorded: Option<CameraPath>,
     /// The descent to the ground: (eye at the end, look-at at the end); `None` for the thesis's flight.
     ground: Option<(DVec3, DVec3)>,
     start: DVec3,
@@ -35,6 +41,7 @@ impl Flight {
             None => (DVec3::Z, DVec3::new(0.3, 0.0, 1.0).normalize()),
         };
         Self {
+            recorded: None,
             ground: None,
             start,
             end,
@@ -56,8 +63,19 @@ impl Flight {
         Some(flight)
     }
 
+    /// A recorded camera path (beyond the thesis: `view --record`, the viewer's bookmarks), one frame each.
+    pub fn recorded(world: &World, path: CameraPath, aspect: f64) -> Self {
+        let mut flight = Self::new(world, path.frames.len() as u32, 1.0, aspect);
+        flight.recorded = Some(path);
+        flight
+    }
+
     /// The camera at `frame`.
     pub fn camera(&self, world: &World, frame: u32) -> Camera {
+        if let Some(path) = &self.recorded {
+            let last = path.frames.len() - 1;
+            return path.frames[(frame as usize).min(last)].camera(self.aspect);
+        }
         if let Some((eye, target)) = self.ground {
             return self.descent_camera(eye, target, frame);
         }

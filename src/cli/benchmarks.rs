@@ -85,6 +85,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             planet,
             stress,
             descent,
+            path,
             hole_images,
             frame_images,
             no_morphing,
@@ -113,6 +114,12 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 std::fs::create_dir_all(dir)
                     .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
             }
+            let path = path
+                .map(|p| {
+                    riverplanet::runtime::camera_path::CameraPath::load(&p).map_err(crate::usage)
+                })
+                .transpose()?;
+            let frames = path.as_ref().map_or(frames, |p| p.frames.len() as u32);
             let world = riverplanet::world::World::build(&config, planet.seed)?;
             let ctx = Context::new(options)?;
             let bar = std::io::stderr()
@@ -126,6 +133,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 compare_kernels: !no_kernel_comparison,
                 compare_water_modes: !no_water_comparison,
                 descent,
+                path,
                 hole_images,
                 frame_images,
                 morphing: !no_morphing,

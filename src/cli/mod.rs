@@ -130,6 +130,13 @@ pub struct RenderArgs {
     /// side of the planet), `mountains` (above the first river's source), `river` (close above the first river).
     #[arg(long, value_enum, conflicts_with_all = ["eye", "look_at", "up"])]
     pub preset: Option<riverplanet::render::presets::Preset>,
+    /// Take the camera from a recorded camera path (`view --record`, or the viewer's bookmarks.json) instead of
+    /// --eye/--look-at: its frame --path-frame, with the viewer's field of view.
+    #[arg(long, conflicts_with_all = ["eye", "look_at", "up", "preset", "fov"])]
+    pub path: Option<PathBuf>,
+    /// With --path: which frame (a bookmark's number), 1 to the path's length [default: the last].
+    #[arg(long, requires = "path", value_parser = clap::value_parser!(u32).range(1..))]
+    pub path_frame: Option<u32>,
     /// Vertical field of view in degrees.
     #[arg(long, default_value_t = 45.0)]
     pub fov: f64,
@@ -200,9 +207,13 @@ pub struct ViewArgs {
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
     /// Where P writes its screenshots (created when the first is taken), each with a JSON sidecar that holds the
-    /// seed, the camera and the `render` command that makes the same image.
+    /// seed, the camera and the `render` command that makes the same image; and B its bookmarks.json.
     #[arg(long, default_value = "out")]
     pub screenshots: PathBuf,
+    /// Write every frame's camera to this JSON file when the viewer closes (a camera path that `render --path`
+    /// and `bench flight --path` replay).
+    #[arg(long)]
+    pub record: Option<PathBuf>,
 }
 
 /// A feature that is on unless switched off.
@@ -376,6 +387,10 @@ pub enum BenchCommand {
         /// preset) instead of the thesis's path.
         #[arg(long, conflicts_with = "stress")]
         descent: bool,
+        /// Replay a recorded camera path (`view --record`, or the viewer's bookmarks.json) instead of the
+        /// thesis's path, one frame per recorded frame (--frames is then the path's length).
+        #[arg(long, conflicts_with_all = ["stress", "descent"])]
+        path: Option<PathBuf>,
         /// With --descent: write the frames whose hole check fails to DIR/holes-FRAME.png.
         #[arg(long, requires = "descent")]
         hole_images: Option<PathBuf>,

@@ -8,7 +8,11 @@ use crate::{check_output, load_config, planet_seed, usage};
 pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()> {
     let (config, _) = load_config(args.planet.config.as_deref())?;
     check_output("--out", &args.out, true)?;
-    if args.preset.is_none() {
+    let recorded = match &args.path {
+        Some(file) => Some(path_frame(file, args.path_frame)?),
+        None => None,
+    };
+    if args.preset.is_none() && recorded.is_none() {
         check_camera(args.eye, args.look_at, &config)?;
     }
     if let Some(up) = args.up {
@@ -27,11 +31,17 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     }
     let seed = planet_seed(args.planet.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
-    let (eye, look_at) = match args.preset {
-        Some(preset) => riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
-            anyhow::anyhow!("preset {preset:?} needs a river, and this planet has none")
-        })?,
-        None => (args.eye, args.look_at),
+    let (eye, look_at) = match (args.preset, &recorded) {
+        (Some(preset), _) => {
+            riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
+                anyhow::anyhow!("preset {preset:?} needs a river, and this planet has none")
+            })?
+        }
+        (None, Some(frame)) => {
+            let eye = glam::DVec3::from_array(frame.position);
+            (eye, eye + glam::DVec3::from_array(frame.forward))
+        }
+        (None, None) => (args.eye, args.look_at),
     };
     println!(
         "camera: --eye {},{},{} --look-at {},{},{}",
@@ -78,6 +88,9 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     );
     if let Some(up) = args.up {
         camera.up = up.normalize();
+    }
+    if let Some(frame) = &recorded {
+        camera = frame.camera(w as f64 / h as f64);
     }
     let c = args.clear_color;
     let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
@@ -134,10 +147,31 @@ fn check_camera(
     Ok(())
 }
 
+/// Frame `number` (1-based; the last without one) of the camera path in `file`.
+fn path_frame(
+    file: &std::path::Path,
+    number: Option<u32>,
+) -> anyhow::Result<riverplanet::runtime::camera_path::PathFrame> {
+    let path = riverplanet::runtime::camera_path::CameraPath::load(file)
+        .map_err(|e| usage(format!("--path {e}")))?;
+    let count = path.frames.len();
+    let k = number.map_or(count, |n| n as usize);
+    if k > count {
+        return Err(usage(format!(
+            "--path-frame {k} must be in [1, {count}] ({} has {count} frames)",
+            file.display()
+        )));
+    }
+    Ok(path.frames[k - 1])
+}
+
 pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
     let (config, _) = load_config(args.planet.config.as_deref())?;
     if let Some(path) = &args.screenshot {
         check_output("--screenshot", path, true)?;
+    }
+    if let Some(path) = &args.record {
+        check_output("--record", path, false)?;
     }
     if let Some(eye) = args.eye {
         check_camera(eye, args.look_at, &config)?;
@@ -165,6 +199,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
             frames: args.frames,
             screenshot: args.screenshot.clone(),
             screenshots: args.screenshots.clone(),
+            record: args.record.clone(),
             config: args.planet.config.clone(),
             water: args.water,
             atmosphere: args.atmosphere.on(),

@@ -1,8 +1,5 @@
 //! The planet's terrain at one level of detail with the rivers carved in, as the renderer draws it (beyond the
-//! thesis, for exports): every patch of the level gets the river kernel's texels from its samples (Sections
-//! 6.3-6.6, the CPU reference, which the GPU kernels equal bit for bit) and each vertex blends the kernel's river
-//! terrain into the base height by the lerp factor (Section 8.2, `mix(terrain, base, lerp)` in the vertex
-//! shaders). A vertex on a patch edge belongs to two patches (four at a corner, three at a cube corner), whose
+//! thesis, for exports): every patch of the level made as `runtime::surface` makes it, into one lattice per face. A vertex on a patch edge belongs to two patches (four at a corner, three at a cube corner), whose
 //! kernels measure distances in their own face planes: within a face they agree to f32 rounding, across a face
 //! edge they can differ by more than the basin depth where a river is near (on the default planet up to 0.15 at
 //! 14 % of the face-edge points of level 2; the renderer's skirts cover the step). The export writes the mean of
@@ -15,12 +12,10 @@ use rayon::prelude::*;
 
 use crate::{
     config::Config,
-    kernel::{cpu::compute_patch, KernelParams, PatchJob},
+    kernel::KernelParams,
     planet::{cube::PatchId, cube::FACES, detail, heights::FaceLattice, Planet},
-    river::{
-        network::RiverNetwork,
-        samples::{patch_samples, PatchFrame},
-    },
+    river::network::RiverNetwork,
+    runtime::surface::{carve_patch, CarvedPatch},
 };
 
 /// The finest level an export computes: level 7 holds 6 x 4097 x 4097 heights (403 MB of f32, about three times
@@ -85,85 +80,6 @@ pub fn carved_terrain(
         }
     }
     lattice
-}
-
-/// One patch's surface as the renderer draws it, per vertex row by row: the terrain height (river beds carved in),
-/// the water height (the river's water, at least sea level), as `surfaceAt` in glsl/terrain_vertex.glsl, and how
-/// far inside a river's basin the vertex lies (half width - |signed distance|; positive inside, as the geometry
-/// shader's test).
-pub struct CarvedPatch {
-    pub patch: PatchId,
-    pub terrain: Vec<f32>,
-    pub water: Vec<f32>,
-    pub basin: Vec<f32>,
-}
-
-/// `patch`'s surface from its base height at vertex (i, j), `base`, and the river kernel where rivers reach it.
-pub fn carve_patch(
-    patch: PatchId,
-    base: impl Fn(u32, u32) -> f32,
-    planet: &Planet,
-    network: &RiverNetwork,
-    n: u32,
-    params: &KernelParams,
-) -> CarvedPatch {
-    let frame = PatchFrame::new(patch, planet.radius, n);
-    let samples = patch_samples(network, &frame).samples;
-    let base_at = |k: u32| base(k % n, k / n);
-    if samples.is_empty() {
-        return CarvedPatch {
-            patch,
-            terrain: (0..n * n).map(base_at).collect(),
-            water: vec![planet.sea_level; (n * n) as usize],
-            basin: vec![-params.influence_distance; (n * n) as usize],
-        };
-    }
-    let job = PatchJob {
-        spacing: frame.spacing() as f32,
-        samples: &samples,
-    };
-    let texels = compute_patch(&job, n, params);
-    CarvedPatch {
-        patch,
-        terrain: texels
-            .iter()
-            .zip(0..)
-            .map(|(t, k)| mix(t.terrain_height, base_at(k), t.lerp_factor))
-            .collect(),
-        water: texels
-            .iter()
-            .map(|t| t.water_height.max(planet.sea_level))
-            .collect(),
-        basin: texels
-            .iter()
-            .map(|t| t.river_width - t.min_distance.abs())
-            .collect(),
-    }
-}
-
-/// The surfaces of `patches` (all of one level), in parallel, each patch's base heights refined on the CPU as the
-/// renderer refines them on the GPU ([`Planet::patch_heights`]).
-pub fn carve_patches(
-    patches: &[PatchId],
-    planet: &Planet,
-    network: &RiverNetwork,
-    config: &Config,
-) -> HashMap<PatchId, CarvedPatch> {
-    let n = config.rendering.vertices;
-    let params = KernelParams::from_config(config);
-    patches
-        .par_iter()
-        .map(|&patch| {
-            let heights = planet.patch_heights(patch);
-            let base = |i: u32, j: u32| heights.get(i as i64, j as i64);
-            (patch, carve_patch(patch, base, planet, network, n, &params))
-        })
-        .collect()
-}
-
-/// GLSL's `mix`, as the vertex shaders blend.
-fn mix(a: f32, b: f32, t: f32) -> f32 {
-    a * (1.0 - t) + b * t
 }
 
 /// The height of `lattice` in the direction `d`, bilinear between the four lattice points around it.

@@ -1,21 +1,16 @@
 //! `riverplanet export region` (beyond the thesis): a longitude-latitude window of the planet at one level of
-//! detail, sampled at pixel centres from the carved patches of that level ([`super::carved`]) that it touches,
+//! detail, sampled at pixel centres from the carved patches of that level (`runtime::surface`) that it touches,
 //! as a georeferenced raster or as a mesh ([`super::mesh`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{
-    carved::{carve_patches, CarvedPatch},
-    raster::Georeference,
-};
+use super::raster::Georeference;
 use crate::{
     config::Config,
-    planet::{
-        cube::{face_of_on, PatchId},
-        direction_at, Planet,
-    },
+    planet::{cube::PatchId, direction_at, Planet},
     river::network::RiverNetwork,
+    runtime::surface::{carve_patches, CarvedPatch},
 };
 
 /// The most pixels (or mesh vertices) a region may have: 16 M (64 MB per f32 layer).
@@ -125,7 +120,7 @@ pub fn sample_region(
     let sample = |layer: fn(&CarvedPatch) -> &[f32]| -> Vec<f32> {
         pixels
             .par_iter()
-            .map(|(d, patch)| bilinear(&carved[patch], layer(&carved[patch]), *d, n))
+            .map(|(d, patch)| carved[patch].at(layer(&carved[patch]), *d, n))
             .collect()
     };
     RegionSurface {
@@ -133,20 +128,4 @@ pub fn sample_region(
         water: sample(|c| &c.water),
         basin: sample(|c| &c.basin),
     }
-}
-
-/// `values` (one per vertex of `surface`'s patch) at direction `d` within the patch.
-fn bilinear(surface: &CarvedPatch, values: &[f32], d: DVec3, n: u32) -> f32 {
-    let patch = surface.patch;
-    let (_, u, v) = face_of_on(patch.face as usize, d);
-    let (u0, v0) = patch.origin();
-    let cells = (n - 1) as f64;
-    let s = ((u - u0) / patch.size() * cells).clamp(0.0, cells);
-    let t = ((v - v0) / patch.size() * cells).clamp(0.0, cells);
-    let (i, j) = ((s as u32).min(n - 2), (t as u32).min(n - 2));
-    let (fs, ft) = ((s - i as f64) as f32, (t - j as f64) as f32);
-    let at = |i: u32, j: u32| values[(j * n + i) as usize];
-    let bottom = at(i, j) + (at(i + 1, j) - at(i, j)) * fs;
-    let top = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * fs;
-    bottom + (top - bottom) * ft
 }

@@ -2,10 +2,12 @@
 //! the viewer.
 
 pub mod frame;
+pub mod ground;
 pub mod mesh;
 pub mod presets;
 pub mod target;
 pub mod viewer;
 pub mod viewer_camera;
+pub mod viewer_paths;
 
 pub use frame::{DrawnVertex, FrameStats, GpuTimes, Renderer, VertexCapture, ViewMode, WaterMode};

@@ -7,7 +7,8 @@
 //! planet), wheel zoom, C fly/orbit, Shift faster; M water mode,
 //! T atmosphere, F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
 //! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, H back to the start
-//! view, P screenshot, Escape quit.
+//! view, P screenshot, B bookmark the view, 1-9 back to a bookmark (viewer_paths.rs), Escape quit. The camera stays
+//! above the drawn surface (ground.rs).
 
 use std::{collections::HashSet, path::PathBuf, time::Instant};
 
@@ -24,8 +25,10 @@ use winit::{
 
 use super::{
     frame::{FrameStats, Renderer, ViewMode},
+    ground::Ground,
     target::{create_depth, Offscreen, DEPTH_FORMAT},
     viewer_camera::{CameraMode, ViewerCamera},
+    viewer_paths::ViewerPaths,
 };
 use crate::{
     config::LodRule,
@@ -47,6 +50,8 @@ pub enum ViewerError {
     Gpu(#[from] GpuError),
     #[error("cannot write screenshot {path}: {message}")]
     Screenshot { path: String, message: String },
+    #[error("cannot write the camera path: {0}")]
+    Path(String),
     #[error("the validation layer reported {count} error(s), the first: {first}")]
     Validation { count: usize, first: String },
 }
@@ -61,8 +66,10 @@ pub struct ViewerOptions {
     pub frames: Option<u64>,
     /// Written after the last frame (with `frames`).
     pub screenshot: Option<PathBuf>,
-    /// Where P writes screenshots, with a JSON sidecar each.
+    /// Where P writes screenshots, with a JSON sidecar each, and B its bookmarks (bookmarks.json).
     pub screenshots: PathBuf,
+    /// Where to write the camera of every frame when the viewer closes (a camera path).
+    pub record: Option<PathBuf>,
     /// The configuration file given, for the sidecar's `render` command (`None`: the default).
     pub config: Option<PathBuf>,
     pub water: super::WaterMode,
@@ -94,6 +101,11 @@ pub fn run(
         DEPTH_FORMAT,
     )?;
     let camera = home(&options, world.planet.radius);
+    let paths = ViewerPaths::new(
+        options.record.clone(),
+        options.screenshots.join("bookmarks.json"),
+        world.seed,
+    );
     let mut app = App {
         ctx: &ctx,
         world,
@@ -104,6 +116,9 @@ pub fn run(
         swapchain: None,
         depth: None,
         camera,
+        ground: Ground::new(world),
+        ground_height: 0.0,
+        paths,
         keys: HashSet::new(),
         dragging: false,
         cursor: None,
@@ -113,12 +128,16 @@ pub fn run(
         last_stats: FrameStats::default(),
         error: None,
     };
+    app.keep_above_ground();
     event_loop.set_control_flow(ControlFlow::Poll);
     let run = event_loop
         .run_app(&mut app)
         .map_err(|e| ViewerError::Window(e.to_string()));
     app.shutdown();
     run?;
+    if let Some(file) = app.paths.finish().map_err(ViewerError::Path)? {
+        println!("camera path: {}", file.display());
+    }
     if let Some(e) = app.error {
         return Err(e);
     }
@@ -138,6 +157,9 @@ fn screenshot_error(path: &std::path::Path, e: impl std::fmt::Display) -> Viewer
         message: e.to_string(),
     }
 }
+
+/// The least height above the drawn surface the camera keeps.
+const MIN_ALTITUDE: f64 = 0.3;
 
 /// The start view, in orbit mode from more than half a radius up, else flying.
 fn home(options: &ViewerOptions, radius: f64) -> ViewerCamera {
@@ -160,6 +182,10 @@ struct App<'a> {
     swapchain: Option<Swapchain>,
     depth: Option<Image>,
     camera: ViewerCamera,
+    ground: Ground,
+    /// The drawn surface's height below the camera (`keep_above_ground` updates it).
+    ground_height: f64,
+    paths: ViewerPaths,
     keys: HashSet<KeyCode>,
     dragging: bool,
     cursor: Option<(f64, f64)>,
@@ -181,15 +207,9 @@ impl App<'_> {
         self.world.planet.radius
     }
 
+    /// Above the drawn surface below the camera.
     fn altitude(&self) -> f64 {
-        let d = self.camera.position;
-        d.length()
-            - self.radius()
-            - self
-                .world
-                .planet
-                .height_at(d)
-                .max(self.world.planet.sea_level) as f64
+        self.camera.position.length() - self.radius() - self.ground_height
     }
 
     fn recreate_swapchain(&mut self) -> Result<(), ViewerError> {
@@ -221,16 +241,12 @@ impl App<'_> {
         )
     }
 
-    /// Keeps the camera above the ground and the water.
+    /// Keeps the camera above the drawn surface (terrain or water) below it.
     fn keep_above_ground(&mut self) {
-        let ground = self.radius()
-            + self
-                .world
-                .planet
-                .height_at(self.camera.position)
-                .max(self.world.planet.sea_level) as f64;
-        if self.camera.position.length() < ground + 0.3 {
-            self.camera.position = self.camera.radial() * (ground + 0.3);
+        self.ground_height = self.ground.height_below(self.camera.position, self.world);
+        let ground = self.radius() + self.ground_height;
+        if self.camera.position.length() < ground + MIN_ALTITUDE {
+            self.camera.position = self.camera.radial() * (ground + MIN_ALTITUDE);
         }
     }
 
@@ -309,6 +325,8 @@ impl App<'_> {
         )?;
         let presented = swapchain.present(self.ctx, index)?;
         self.frames += 1;
+        let altitude = self.altitude();
+        self.paths.record(&self.camera, altitude);
         self.smoothed_ms = if self.frames == 1 {
             stats.frame_ms
         } else {
@@ -427,7 +445,32 @@ impl App<'_> {
         match code {
             KeyCode::Escape => event_loop.exit(),
             // Home: back to the start view, wherever the flight went.
-            KeyCode::KeyH => self.camera = home(&self.options, self.radius()),
+            KeyCode::KeyH => {
+                self.camera = home(&self.options, self.radius());
+                self.keep_above_ground();
+            }
+            KeyCode::KeyB => {
+                let altitude = self.altitude();
+                match self.paths.bookmark(&self.camera, altitude) {
+                    Ok(k) => println!("bookmark {k}: key {k} flies back here"),
+                    Err(e) => log::error!("cannot save the bookmark: {e}"),
+                }
+            }
+            KeyCode::Digit1
+            | KeyCode::Digit2
+            | KeyCode::Digit3
+            | KeyCode::Digit4
+            | KeyCode::Digit5
+            | KeyCode::Digit6
+            | KeyCode::Digit7
+            | KeyCode::Digit8
+            | KeyCode::Digit9 => {
+                let k = code as usize - KeyCode::Digit0 as usize;
+                if let Some(camera) = self.paths.recall(k, self.radius()) {
+                    self.camera = camera;
+                    self.keep_above_ground();
+                }
+            }
             KeyCode::KeyC => {
                 self.camera.mode = match self.camera.mode {
                     CameraMode::Fly => CameraMode::Orbit,
@@ -565,6 +608,7 @@ impl ApplicationHandler for App<'_> {
                 if let (true, Some((x, y))) = (self.dragging, self.cursor) {
                     let altitude = self.altitude();
                     self.camera.drag(position.x - x, position.y - y, altitude);
+                    self.keep_above_ground();
                 }
                 self.cursor = Some((position.x, position.y));
             }

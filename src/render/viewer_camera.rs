@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::{DQuat, DVec3};
 
-use crate::runtime::camera::Camera;
+use crate::runtime::{camera::Camera, camera_path::FOV_DEGREES};
 
 /// What a drag does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,9 +16,6 @@ pub enum CameraMode {
     /// A drag turns the view around the planet's centre.
     Orbit,
 }
-
-/// The viewer's vertical field of view, degrees.
-pub const FOV_DEGREES: f64 = 60.0;
 
 /// Radians per pixel of a drag (fly: the view turns; orbit: at an altitude of one planet radius or more).
 const DRAG_RADIANS: f64 = 0.004;
@@ -112,7 +109,7 @@ impl ViewerCamera {
         let mut camera = Camera::look_at(
             self.position,
             self.position + self.forward,
-            60.0,
+            FOV_DEGREES,
             aspect,
             near,
         );
