@@ -210,6 +210,9 @@ pub struct ViewArgs {
     /// seed, the camera and the `render` command that makes the same image; and B its bookmarks.json.
     #[arg(long, default_value = "out")]
     pub screenshots: PathBuf,
+    /// The on-screen overlay (settings, times, keys) at the start; U shows or hides it.
+    #[arg(long, value_enum, default_value = "on")]
+    pub overlay: Switch,
     /// Write every frame's camera to this JSON file when the viewer closes (a camera path that `render --path`
     /// and `bench flight --path` replay).
     #[arg(long)]

@@ -200,6 +200,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
             screenshot: args.screenshot.clone(),
             screenshots: args.screenshots.clone(),
             record: args.record.clone(),
+            overlay: args.overlay.on(),
             config: args.planet.config.clone(),
             water: args.water,
             atmosphere: args.atmosphere.on(),

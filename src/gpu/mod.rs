@@ -4,13 +4,15 @@
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
 //! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`frames`] (the ring of
 //! frame contexts that keeps frames in flight), [`bindless`] (the global descriptor-indexed set), [`pipeline`]
-//! (shader modules and pipelines), [`profiler`] (timestamp scopes), [`swapchain`] (window presentation).
+//! (shader modules and pipelines), [`profiler`] (timestamp scopes), [`swapchain`] (window presentation), [`overlay`]
+//! (egui's triangles, for the viewer).
 
 pub mod bindless;
 pub mod context;
 pub mod features;
 pub mod frames;
 pub mod memory;
+pub mod overlay;
 pub mod pipeline;
 pub mod profiler;
 pub mod submit;

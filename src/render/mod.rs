@@ -4,6 +4,7 @@
 pub mod frame;
 pub mod ground;
 pub mod mesh;
+pub mod overlay;
 pub mod presets;
 pub mod target;
 pub mod viewer;

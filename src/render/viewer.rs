@@ -26,6 +26,7 @@ use winit::{
 use super::{
     frame::{FrameStats, Renderer, ViewMode},
     ground::Ground,
+    overlay::{Overlay, ViewInfo},
     target::{create_depth, Offscreen, DEPTH_FORMAT},
     viewer_camera::{CameraMode, ViewerCamera},
     viewer_paths::ViewerPaths,
@@ -70,6 +71,8 @@ pub struct ViewerOptions {
     pub screenshots: PathBuf,
     /// Where to write the camera of every frame when the viewer closes (a camera path).
     pub record: Option<PathBuf>,
+    /// Show the on-screen overlay at the start (U toggles it).
+    pub overlay: bool,
     /// The configuration file given, for the sidecar's `render` command (`None`: the default).
     pub config: Option<PathBuf>,
     pub water: super::WaterMode,
@@ -110,6 +113,7 @@ pub fn run(
         ctx: &ctx,
         world,
         renderer: Some(renderer),
+        overlay: None,
         options,
         window: None,
         surface: None,
@@ -176,6 +180,7 @@ struct App<'a> {
     ctx: &'a Context,
     world: &'a World,
     renderer: Option<Renderer<'a>>,
+    overlay: Option<Overlay>,
     options: ViewerOptions,
     window: Option<Window>,
     surface: Option<Surface>,
@@ -191,6 +196,7 @@ struct App<'a> {
     cursor: Option<(f64, f64)>,
     last: Instant,
     frames: u64,
+    /// Time between frames, exponentially smoothed.
     smoothed_ms: f64,
     last_stats: FrameStats,
     error: Option<ViewerError>,
@@ -316,21 +322,46 @@ impl App<'_> {
             extent,
             clear_color: [0.02, 0.03, 0.06, 1.0],
         };
-        let stats = renderer.render(
+        let info = ViewInfo {
+            seed: self.world.seed,
+            altitude: self.camera.position.length() - self.world.planet.radius - self.ground_height,
+            mode: self.camera.mode,
+            frame_ms: self.smoothed_ms,
+        };
+        if let (Some(overlay), Some(window)) = (&mut self.overlay, &self.window) {
+            overlay.prepare(self.ctx, window, renderer, (&info, &self.last_stats))?;
+        }
+        let mut overlay_error = None;
+        let mut draw_overlay = |rec: &mut crate::gpu::Recorder, extent| {
+            if let Some(overlay) = &mut self.overlay {
+                if let Err(e) = overlay.record(rec, extent) {
+                    overlay_error = Some(e);
+                }
+            }
+        };
+        let stats = renderer.render_with_overlay(
             &camera,
             &target,
             (vk::ImageLayout::UNDEFINED, vk::ImageLayout::PRESENT_SRC_KHR),
-            &[(acquired, vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)],
-            &[rendered],
+            (
+                &[(acquired, vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)],
+                &[rendered],
+            ),
+            Some(&mut draw_overlay),
         )?;
+        if let Some(e) = overlay_error {
+            return Err(e.into());
+        }
         let presented = swapchain.present(self.ctx, index)?;
         self.frames += 1;
         let altitude = self.altitude();
         self.paths.record(&self.camera, altitude);
+        // Wall-clock time between frames (what the eye sees), not the CPU's share of it.
+        let interval_ms = dt * 1e3;
         self.smoothed_ms = if self.frames == 1 {
-            stats.frame_ms
+            interval_ms
         } else {
-            0.9 * self.smoothed_ms + 0.1 * stats.frame_ms
+            0.9 * self.smoothed_ms + 0.1 * interval_ms
         };
         self.update_title(&stats);
         self.last_stats = stats;
@@ -382,18 +413,27 @@ impl App<'_> {
         let Some(renderer) = &mut self.renderer else {
             return Ok(());
         };
+        let overlay = &mut self.overlay;
         let target = Offscreen::with_format(self.ctx, w, h, SWAPCHAIN_FORMAT)?;
         let result = (|| {
             for _ in 0..50 {
-                let stats = renderer.render(
+                // The overlay as shown (what you see is what you get; U hides it).
+                let mut draw_overlay = |rec: &mut crate::gpu::Recorder, extent| {
+                    if let Some(overlay) = overlay.as_mut() {
+                        if let Err(e) = overlay.record(rec, extent) {
+                            log::error!("{e}");
+                        }
+                    }
+                };
+                let stats = renderer.render_with_overlay(
                     &camera,
                     &target.target([0.02, 0.03, 0.06, 1.0]),
                     (
                         vk::ImageLayout::UNDEFINED,
                         vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                     ),
-                    &[],
-                    &[],
+                    (&[], &[]),
+                    Some(&mut draw_overlay),
                 )?;
                 if stats.pending_patches == 0 && stats.fallback_patches == 0 {
                     break;
@@ -477,6 +517,11 @@ impl App<'_> {
                     CameraMode::Orbit => CameraMode::Fly,
                 }
             }
+            KeyCode::KeyU => {
+                if let Some(overlay) = &mut self.overlay {
+                    overlay.visible = !overlay.visible;
+                }
+            }
             KeyCode::KeyM => renderer.water_mode = renderer.water_mode.next(),
             KeyCode::KeyT => renderer.atmosphere_on = !renderer.atmosphere_on,
             KeyCode::KeyF => renderer.wireframe_on = !renderer.wireframe_on,
@@ -522,6 +567,9 @@ impl App<'_> {
         if let Some(renderer) = self.renderer.take() {
             renderer.destroy();
         }
+        if let Some(overlay) = self.overlay.take() {
+            overlay.destroy(self.ctx);
+        }
         if let Some(swapchain) = self.swapchain.take() {
             swapchain.destroy(self.ctx);
         }
@@ -563,6 +611,15 @@ impl ApplicationHandler for App<'_> {
             Ok(s) => self.surface = Some(s),
             Err(e) => return self.fail(event_loop, e),
         }
+        match Overlay::new(
+            self.ctx,
+            &window,
+            (SWAPCHAIN_FORMAT, DEPTH_FORMAT),
+            self.options.overlay,
+        ) {
+            Ok(o) => self.overlay = Some(o),
+            Err(e) => return self.fail(event_loop, e.into()),
+        }
         self.window = Some(window);
         if let Some(renderer) = &mut self.renderer {
             renderer.water_mode = self.options.water;
@@ -575,6 +632,30 @@ impl ApplicationHandler for App<'_> {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let taken = match (&mut self.overlay, &self.window) {
+            (Some(overlay), Some(window)) => overlay.on_event(window, &event),
+            _ => false,
+        };
+        let input = matches!(
+            event,
+            WindowEvent::KeyboardInput { .. }
+                | WindowEvent::MouseInput { .. }
+                | WindowEvent::CursorMoved { .. }
+                | WindowEvent::MouseWheel { .. }
+        );
+        if taken && input {
+            // A release still reaches the camera, so no key or drag stays stuck.
+            match event {
+                WindowEvent::MouseInput { .. } => self.dragging = false,
+                WindowEvent::KeyboardInput { event, .. } => {
+                    if let PhysicalKey::Code(code) = event.physical_key {
+                        self.keys.remove(&code);
+                    }
+                }
+                _ => {}
+            }
+            return;
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(_) => {

@@ -150,6 +150,7 @@ impl Renderer<'_> {
         visible: &[Selected],
         (target, color_layouts): (&RenderTarget, (vk::ImageLayout, vk::ImageLayout)),
         stats: &mut FrameStats,
+        overlay: Option<super::Overlay<'_>>,
     ) -> Result<Drawn, GpuError> {
         let ctx = self.ctx;
         let radius = self.planet.radius;
@@ -368,6 +369,9 @@ impl Renderer<'_> {
             let scope = self.frames.profiler().begin(rec, "sky")?;
             sky.record(rec, &sets, push);
             self.frames.profiler().end(rec, scope);
+        }
+        if let Some(draw) = overlay {
+            draw(rec, target.extent);
         }
         rec.end_rendering();
         if color_layouts.1 != vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL {

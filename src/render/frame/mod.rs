@@ -46,6 +46,9 @@ use crate::{
     shaders,
 };
 
+/// Draws recorded into a frame's rendering after its own passes (the viewer's overlay).
+pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, vk::Extent2D);
+
 /// How rivers are drawn (Section 8.4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
@@ -404,6 +407,22 @@ impl<'w> Renderer<'w> {
         waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
         signals: &[vk::Semaphore],
     ) -> Result<FrameStats, GpuError> {
+        self.render_with_overlay(camera, target, color_layouts, (waits, signals), None)
+    }
+
+    /// As [`Renderer::render`], with `overlay` recording its draws into the frame's rendering after the sky (the
+    /// viewer's on-screen overlay).
+    pub fn render_with_overlay(
+        &mut self,
+        camera: &Camera,
+        target: &RenderTarget,
+        color_layouts: (vk::ImageLayout, vk::ImageLayout),
+        (waits, signals): (
+            &[(vk::Semaphore, vk::PipelineStageFlags2)],
+            &[vk::Semaphore],
+        ),
+        overlay: Option<Overlay<'_>>,
+    ) -> Result<FrameStats, GpuError> {
         let start = Instant::now();
         let ctx = self.ctx;
         self.frame += 1;
@@ -439,6 +458,7 @@ impl<'w> Renderer<'w> {
             &visible,
             (target, color_layouts),
             &mut stats,
+            overlay,
         )?;
         cpu.insert("record".to_string(), ms_since(t));
 
@@ -475,6 +495,13 @@ impl<'w> Renderer<'w> {
             stats.frame_ms
         );
         Ok(stats)
+    }
+
+    /// The screen-space-error rule's pixel error and Eq. 6.1's switch factor, changeable between frames (the
+    /// viewer's overlay).
+    pub fn level_of_detail_settings(&mut self) -> (&mut f32, &mut f32) {
+        let r = &mut self.config.rendering;
+        (&mut r.pixel_error, &mut r.level_of_detail_switch_factor)
     }
 
     /// A free bindless slot, evicting the least recently used patches if none is left, and waiting for the frames
