@@ -3,6 +3,8 @@
 //! through the `image` crate, glTF through the `gltf` crate's importer), their values checked against the library's carved heights, the river channels
 //! found below the land at the rivers' own coordinates, and the faces agreeing across their seams.
 
+mod common;
+
 use std::{collections::HashMap, path::Path, process::Command};
 
 use glam::DVec3;
@@ -516,4 +518,67 @@ fn a_region_exports_as_a_georeferenced_raster_and_as_a_gltf_mesh_at_the_same_hei
         }
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The exports' surface is the renderer's: close above the first river (the `river` preset), every grid vertex
+/// the terrain pass draws unmorphed (captured from the vertex shader) lies at the height `runtime::surface` gives
+/// its patch's grid point on the CPU (the exports' source), within a thousandth of a unit (f32 positions relative
+/// to the camera, and the blend's rounding on two sides).
+#[test]
+fn the_exported_surface_is_the_surface_the_renderer_draws() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = default_world();
+    let (eye, target) =
+        riverplanet::render::presets::camera(riverplanet::render::presets::Preset::River, &world)
+            .unwrap();
+    let camera = riverplanet::runtime::camera::Camera::look_at(eye, target, 60.0, 16.0 / 9.0, 0.05);
+    let offscreen = riverplanet::render::target::Offscreen::new(ctx, 320, 180).unwrap();
+    let mut renderer = common::renderer(ctx, &world);
+    let mut layout = riverplanet::gpu::vk::ImageLayout::UNDEFINED;
+    let clear = offscreen.target([0.0, 0.0, 0.0, 1.0]);
+    renderer
+        .render_until_streamed(&camera, &clear, &mut layout, 200)
+        .unwrap();
+    renderer.capture_vertices = true;
+    renderer
+        .render_until_streamed(&camera, &clear, &mut layout, 1)
+        .unwrap();
+    let capture = renderer.last_capture.take().unwrap();
+    renderer.destroy();
+    offscreen.destroy(ctx);
+    common::assert_no_validation_errors(ctx);
+
+    let unmorphed: Vec<_> = capture.drawn().filter(|v| v.morph == 0.0).collect();
+    let mut patches: Vec<_> = unmorphed.iter().map(|v| v.patch).collect();
+    patches.sort_unstable();
+    patches.dedup();
+    let surfaces = riverplanet::runtime::surface::carve_patches(
+        &patches,
+        &world.planet,
+        &world.network,
+        &world.config,
+    );
+    let n = world.config.rendering.vertices;
+    let radius = world.planet.radius;
+    let mut worst = 0.0f64;
+    let mut carved = 0;
+    for v in &unmorphed {
+        let drawn = (capture.camera + v.relative).length() - radius;
+        let surface = &surfaces[&v.patch];
+        let index = (v.j * n + v.i) as usize;
+        let exported = surface.terrain[index] as f64;
+        worst = worst.max((drawn - exported).abs());
+        carved += usize::from(surface.basin[index] > -world.config.river.influence_distance);
+    }
+    println!(
+        "{} unmorphed vertices of {} patches ({carved} within a river's reach): largest difference {worst}",
+        unmorphed.len(),
+        patches.len()
+    );
+    assert!(unmorphed.len() > 5_000, "only {} vertices", unmorphed.len());
+    assert!(carved > 1_000, "only {carved} vertices near rivers");
+    assert!(
+        worst < 1e-3,
+        "the renderer draws {worst} away from the export"
+    );
 }
