@@ -1,5 +1,6 @@
 //! `riverplanet export faces`, `export equirect` and `export region`: the files read back by a reader of their own (a TIFF reader
-//! written here from the TIFF 6.0 and GeoTIFF 1.1 specifications, not the `tiff` crate that writes them; PNGs
+//! written here from the TIFF 6.0 and GeoTIFF 1.1 specifications, not the `tiff` crate that writes them, and an
+//! OpenEXR reader from the OpenEXR file layout, not the `exr` crate; PNGs
 //! through the `image` crate, glTF through the `gltf` crate's importer), their values checked against the library's carved heights, the river channels
 //! found below the land at the rivers' own coordinates, and the faces agreeing across their seams.
 
@@ -119,6 +120,70 @@ fn read_tiff(path: &Path) -> Tiff {
     }
 }
 
+/// Reads a single-part, uncompressed scan-line OpenEXR file of one FLOAT channel (OpenEXR file layout: magic
+/// number, version, header attributes up to an empty name, the line offset table, one chunk per line of y, size
+/// and the line's samples): its size, its values, and the text attribute `riverplanet`.
+fn read_exr(path: &Path) -> (u32, u32, Vec<f32>, String) {
+    let bytes = std::fs::read(path).unwrap();
+    let i32_at = |o: usize| i32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    assert_eq!(
+        &bytes[0..4],
+        &[0x76, 0x2f, 0x31, 0x01],
+        "OpenEXR magic number"
+    );
+    assert_eq!(bytes[4], 2, "version 2");
+    assert_eq!(bytes[5] & 0x1e, 0, "single-part scan lines");
+    let mut at = 8;
+    let c_string = |at: &mut usize| {
+        let end = *at + bytes[*at..].iter().position(|&b| b == 0).unwrap();
+        let text = String::from_utf8(bytes[*at..end].to_vec()).unwrap();
+        *at = end + 1;
+        text
+    };
+    let (mut window, mut metadata) = ([0i32; 4], String::new());
+    loop {
+        let name = c_string(&mut at);
+        if name.is_empty() {
+            break;
+        }
+        let kind = c_string(&mut at);
+        let size = i32_at(at) as usize;
+        let value = at + 4;
+        match (name.as_str(), kind.as_str()) {
+            ("dataWindow", "box2i") => window = [0, 4, 8, 12].map(|k| i32_at(value + k)),
+            ("compression", _) => assert_eq!(bytes[value], 0, "no compression"),
+            ("channels", _) => {
+                let mut c = value;
+                assert_eq!(c_string(&mut c), "Y");
+                assert_eq!(i32_at(c), 2, "FLOAT samples");
+            }
+            ("riverplanet", "string") => {
+                metadata = String::from_utf8(bytes[value..value + size].to_vec()).unwrap()
+            }
+            _ => {}
+        }
+        at = value + size;
+    }
+    let (width, height) = (
+        (window[2] - window[0] + 1) as u32,
+        (window[3] - window[1] + 1) as u32,
+    );
+    let offsets: Vec<usize> = (0..height as usize)
+        .map(|k| u64::from_le_bytes(bytes[at + 8 * k..at + 8 * k + 8].try_into().unwrap()) as usize)
+        .collect();
+    let mut values = vec![0.0f32; (width * height) as usize];
+    for offset in offsets {
+        let y = (i32_at(offset) - window[1]) as usize;
+        assert_eq!(i32_at(offset + 4) as u32, width * 4);
+        for x in 0..width as usize {
+            let o = offset + 8 + 4 * x;
+            values[y * width as usize + x] =
+                f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+        }
+    }
+    (width, height, values, metadata)
+}
+
 fn default_world() -> World {
     let config = Config::load(Path::new("config/planet.xml")).unwrap();
     World::build(&config, 1).unwrap()
@@ -177,13 +242,13 @@ fn the_equirectangular_geotiff_is_georeferenced_and_holds_the_carved_heights() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The six faces as TIFF and PNG: the same heights in both (the PNG within one step of its scale), and the
+/// The six faces as TIFF, OpenEXR and PNG: the same heights in all (the PNG within one step of its scale), and the
 /// lattice points that two or three faces share, found through layout.json's orientations, equal on every face
 /// that holds them (the export writes the mean of the patches' values there).
 #[test]
 fn face_rasters_agree_with_each_other_and_across_their_seams() {
     let dir = temp_dir("faces");
-    for format in ["tiff", "png"] {
+    for format in ["tiff", "exr", "png"] {
         let out = dir.join(format);
         succeed(&[
             "export",
@@ -210,6 +275,11 @@ fn face_rasters_agree_with_each_other_and_across_their_seams() {
         let entry = &layout["faces"][face];
         let tiff = read_tiff(&dir.join("tiff").join(entry["file"].as_str().unwrap()));
         assert_eq!((tiff.width, tiff.height), (129, 129));
+        let (width, height, exr, metadata) = read_exr(&dir.join(format!("exr/face{face}.exr")));
+        assert_eq!((width, height), (129, 129));
+        assert_eq!(exr, tiff.values, "face {face}: EXR and TIFF differ");
+        let metadata: Value = serde_json::from_str(&metadata).unwrap();
+        assert_eq!(metadata["radius"], 1024.0);
         let png_entry = &png_layout["faces"][face];
         let png = image::open(dir.join("png").join(png_entry["file"].as_str().unwrap()))
             .unwrap()
@@ -283,11 +353,11 @@ fn height_exports_refuse_bad_arguments_before_any_work() {
                 "export",
                 "faces",
                 "--format",
-                "exr",
+                "jpg",
                 "--out",
                 dir.to_str().unwrap(),
             ],
-            "tiff (32-bit float) or png",
+            "tiff or exr (32-bit float) or png",
         ),
         (
             vec!["export", "equirect", "--out", png.to_str().unwrap()],

@@ -248,7 +248,7 @@ pub struct PlanetArgs {
 #[derive(Subcommand)]
 pub enum ExportCommand {
     /// The terrain with the rivers carved in (as the renderer draws it) at one level of detail, as six cube-face
-    /// rasters face{0..5}.tif (32-bit float) or .png (16-bit) and layout.json: radius, units, sea level, how
+    /// rasters face{0..5}.tif or .exr (32-bit float) or .png (16-bit) and layout.json: radius, units, sea level, how
     /// values turn into heights, and each face's orientation.
     Faces {
         #[command(flatten)]
@@ -256,7 +256,7 @@ pub enum ExportCommand {
         /// Level of detail, 0 to 7: faces of 32 x 2^level + 1 pixels a side.
         #[arg(long, default_value_t = 4)]
         level: u32,
-        /// tiff (32-bit float heights) or png (16-bit grey, one height range for all faces).
+        /// tiff or exr (32-bit float heights) or png (16-bit grey, one height range for all faces).
         #[arg(long, value_parser = RasterFormat::parse, default_value = "tiff")]
         format: RasterFormat,
         /// The folder to write into (made if missing; its parent must exist).
@@ -275,10 +275,10 @@ pub enum ExportCommand {
         /// apart than the pixels, at most 7].
         #[arg(long)]
         level: Option<u32>,
-        /// tiff (32-bit float GeoTIFF) or png (16-bit grey).
+        /// tiff (32-bit float GeoTIFF), exr (32-bit float OpenEXR) or png (16-bit grey).
         #[arg(long, value_parser = RasterFormat::parse, default_value = "tiff")]
         format: RasterFormat,
-        /// The file: .tif or .tiff for tiff, .png for png.
+        /// The file: .tif or .tiff for tiff, .exr for exr, .png for png.
         #[arg(long)]
         out: PathBuf,
     },
@@ -294,10 +294,10 @@ pub enum ExportCommand {
         /// Level of detail, 0 to 20: samples about one vertex spacing of that level apart.
         #[arg(long, default_value_t = 6)]
         level: u32,
-        /// tiff (32-bit float GeoTIFF), png (16-bit grey) or glb (mesh).
+        /// tiff (32-bit float GeoTIFF), exr (32-bit float OpenEXR), png (16-bit grey) or glb (mesh).
         #[arg(long, value_parser = RegionFormat::parse, default_value = "tiff")]
         format: RegionFormat,
-        /// The file: .tif or .tiff, .png, or .glb, as --format says.
+        /// The file: .tif or .tiff, .exr, .png, or .glb, as --format says.
         #[arg(long)]
         out: PathBuf,
     },
@@ -330,7 +330,7 @@ impl RegionFormat {
             "glb" => Ok(Self::Glb),
             _ => RasterFormat::parse(text)
                 .map(Self::Raster)
-                .map_err(|_| format!("'{text}' is not a region format: tiff, png or glb")),
+                .map_err(|_| format!("'{text}' is not a region format: tiff, exr, png or glb")),
         }
     }
 }

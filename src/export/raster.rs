@@ -1,5 +1,6 @@
 //! Height rasters for other tools (beyond the thesis): 32-bit float TIFF (uncompressed, which every reader
-//! takes; GeoTIFF keys for longitude-latitude grids) and 16-bit grey PNG. Their metadata (radius, units, sea
+//! takes; GeoTIFF keys for longitude-latitude grids), 32-bit float OpenEXR (one channel Y, uncompressed, through
+//! the `exr` crate; what film and terrain tools read) and 16-bit grey PNG. Their metadata (radius, units, sea
 //! level, and the scale and offset that turn a pixel value into a height) goes into the TIFF's ImageDescription
 //! as JSON and into the JSON the caller writes beside the files.
 
@@ -20,6 +21,8 @@ use super::{files, ExportError};
 pub enum RasterFormat {
     /// 32-bit float heights, as they are.
     Tiff,
+    /// 32-bit float heights in channel Y.
+    Exr,
     /// 16-bit grey: the raster's lowest to highest height mapped to 0..65535.
     Png,
 }
@@ -28,9 +31,10 @@ impl RasterFormat {
     pub fn parse(text: &str) -> Result<Self, String> {
         match text {
             "tiff" | "tif" => Ok(Self::Tiff),
+            "exr" => Ok(Self::Exr),
             "png" => Ok(Self::Png),
             _ => Err(format!(
-                "'{text}' is not a height format: tiff (32-bit float) or png (16-bit)"
+                "'{text}' is not a height format: tiff or exr (32-bit float) or png (16-bit)"
             )),
         }
     }
@@ -39,6 +43,7 @@ impl RasterFormat {
     pub fn name(self) -> &'static str {
         match self {
             Self::Tiff => "tiff",
+            Self::Exr => "exr",
             Self::Png => "png",
         }
     }
@@ -46,6 +51,7 @@ impl RasterFormat {
     pub fn extension(self) -> &'static str {
         match self {
             Self::Tiff => "tif",
+            Self::Exr => "exr",
             Self::Png => "png",
         }
     }
@@ -58,7 +64,7 @@ impl RasterFormat {
             .map(str::to_ascii_lowercase);
         match self {
             Self::Tiff => matches!(extension.as_deref(), Some("tif" | "tiff")),
-            Self::Png => extension.as_deref() == Some("png"),
+            Self::Exr | Self::Png => extension.as_deref() == Some(self.extension()),
         }
     }
 }
@@ -103,12 +109,13 @@ pub fn write_raster(
 ) -> Result<Value, ExportError> {
     let (lo, hi) = raster.range;
     let (scale, offset) = match format {
-        RasterFormat::Tiff => (1.0, 0.0),
+        RasterFormat::Tiff | RasterFormat::Exr => (1.0, 0.0),
         RasterFormat::Png => ((hi - lo).max(0.0) as f64 / 65535.0, lo as f64),
     };
     let mut metadata = metadata.clone();
     metadata["format"] = json!(match format {
         RasterFormat::Tiff => "32-bit float TIFF",
+        RasterFormat::Exr => "32-bit float OpenEXR, channel Y",
         RasterFormat::Png => "16-bit grey PNG",
     });
     metadata["size"] = json!([raster.width, raster.height]);
@@ -119,6 +126,7 @@ pub fn write_raster(
     metadata["max_height"] = json!(max);
     match format {
         RasterFormat::Tiff => write_tiff(path, raster, &metadata.to_string(), geo)?,
+        RasterFormat::Exr => write_exr(path, raster, &metadata.to_string())?,
         RasterFormat::Png => write_png(path, raster, scale, offset)?,
     }
     Ok(metadata)
@@ -190,6 +198,30 @@ fn write_geokeys<W: std::io::Write + std::io::Seek, K: tiff::encoder::TiffKind>(
         Tag::ModelTiepointTag,
         &[0.0, 0.0, 0.0, g.west, g.north, 0.0][..],
     )
+}
+
+/// One uncompressed scan-line part, channel Y, with the metadata as the text attribute `riverplanet`.
+fn write_exr(path: &Path, raster: &Raster, description: &str) -> Result<(), ExportError> {
+    use exr::prelude::*;
+    let size = (raster.width as usize, raster.height as usize);
+    let mut attributes = LayerAttributes::named("height");
+    attributes.other.insert(
+        Text::from("riverplanet"),
+        AttributeValue::Text(Text::from(description)),
+    );
+    let channel = AnyChannel::new("Y", FlatSamples::F32(raster.heights.to_vec()));
+    let layer = Layer::new(
+        size,
+        attributes,
+        Encoding::UNCOMPRESSED,
+        AnyChannels::sort(vec![channel].into()),
+    );
+    files::write_atomically(path, |temporary| {
+        Image::from_layer(layer)
+            .write()
+            .to_file(temporary)
+            .map_err(|e| e.to_string())
+    })
 }
 
 fn write_png(path: &Path, raster: &Raster, scale: f64, offset: f64) -> Result<(), ExportError> {
