@@ -16,6 +16,7 @@ pub mod drainage;
 pub mod export;
 pub mod gpu;
 pub mod kernel;
+pub mod named;
 pub mod planet;
 pub mod refine;
 pub mod render;

@@ -13,6 +13,7 @@ use riverplanet::{
     config::LodRule,
     export::raster::RasterFormat,
     kernel::gpu::KernelTuning,
+    named::Named,
     render::{ViewMode, WaterMode},
 };
 
@@ -128,7 +129,7 @@ pub struct RenderArgs {
     pub up: Option<glam::DVec3>,
     /// Place the camera from the planet's own features instead of --eye/--look-at: `orbit` (the first river's
     /// side of the planet), `mountains` (above the first river's source), `river` (close above the first river).
-    #[arg(long, value_enum, conflicts_with_all = ["eye", "look_at", "up"])]
+    #[arg(long, value_parser = named::<riverplanet::render::presets::Preset>(), conflicts_with_all = ["eye", "look_at", "up"])]
     pub preset: Option<riverplanet::render::presets::Preset>,
     /// Take the camera from a recorded camera path (`view --record`, or the viewer's bookmarks.json) instead of
     /// --eye/--look-at: its frame --path-frame, with the viewer's field of view.
@@ -142,11 +143,11 @@ pub struct RenderArgs {
     pub fov: f64,
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
     pub size: [u32; 2],
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_parser = named::<WaterMode>(), default_value = "auto")]
     pub water: WaterMode,
-    #[arg(long, value_enum, default_value = "shaded")]
+    #[arg(long, value_parser = named::<ViewMode>(), default_value = "shaded")]
     pub view: ViewMode,
-    #[arg(long, value_enum, default_value = "tiled")]
+    #[arg(long, value_parser = named::<riverplanet::kernel::gpu::KernelVariant>(), default_value = "tiled")]
     pub kernel: riverplanet::kernel::gpu::KernelVariant,
     /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching, instead of nearest-point
     /// selection with morphing.
@@ -191,7 +192,7 @@ pub struct ViewArgs {
     pub eye: Option<glam::DVec3>,
     #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
     pub look_at: glam::DVec3,
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_parser = named::<WaterMode>(), default_value = "auto")]
     pub water: WaterMode,
     /// The atmosphere (single scattering in the shell of atmosphere-height; beyond the thesis). `off`: a
     /// constant haze and the clear colour behind the planet, for comparisons.
@@ -315,6 +316,14 @@ pub enum ExportCommand {
         #[arg(long)]
         out: PathBuf,
     },
+}
+
+/// The parser of a library's named values ([`Named`]): its names, listed in --help, to its values (the library
+/// does not depend on clap).
+fn named<T: Named + Clone + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(T::ALL.iter().map(|(name, _)| *name))
+        .try_map(|name: String| T::from_name(&name).ok_or(format!("'{name}' has no value")))
 }
 
 /// What `export region` writes.

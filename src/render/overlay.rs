@@ -15,6 +15,7 @@ use crate::{
     config::LodRule,
     gpu::{overlay::OverlayRenderer, vk, Context, GpuError, Recorder},
     kernel::gpu::KernelVariant,
+    named::Named,
 };
 
 /// What the overlay shows that the renderer does not hold.
@@ -140,10 +141,10 @@ fn panel(egui: &egui::Context, renderer: &mut Renderer, info: &ViewInfo, stats: 
             ));
             ui.separator();
             ComboBox::from_label("water")
-                .selected_text(format!("{:?}", renderer.water_mode))
+                .selected_text(renderer.water_mode.name())
                 .show_ui(ui, |ui| {
-                    for mode in [WaterMode::Auto, WaterMode::Geometry, WaterMode::Painted] {
-                        ui.selectable_value(&mut renderer.water_mode, mode, format!("{mode:?}"));
+                    for &(name, mode) in WaterMode::ALL {
+                        ui.selectable_value(&mut renderer.water_mode, mode, name);
                     }
                 });
             ui.horizontal(|ui| {

@@ -8,7 +8,7 @@ use crate::{
     world::World,
 };
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
     /// The whole planet from orbit, centred on the first river.
     Orbit,
@@ -104,4 +104,13 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             (here * (r + water + GROUND_EYE_HEIGHT), ahead * (r + water))
         }
     })
+}
+
+impl crate::named::Named for Preset {
+    const ALL: &'static [(&'static str, Self)] = &[
+        ("orbit", Self::Orbit),
+        ("mountains", Self::Mountains),
+        ("river", Self::River),
+        ("ground", Self::Ground),
+    ];
 }

@@ -25,7 +25,7 @@ use crate::{
 };
 
 /// Which compute shader runs the kernel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum KernelVariant {
     /// One invocation per vertex, samples read from the storage buffer (7.3.1).
     Simple,
@@ -311,4 +311,9 @@ pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result
         aspect: vk::ImageAspectFlags::COLOR,
         array: true,
     })
+}
+
+impl crate::named::Named for KernelVariant {
+    const ALL: &'static [(&'static str, Self)] =
+        &[("simple", Self::Simple), ("tiled", Self::Tiled)];
 }

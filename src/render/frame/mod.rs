@@ -50,7 +50,7 @@ use crate::{
 pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, vk::Extent2D);
 
 /// How rivers are drawn (Section 8.4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum WaterMode {
     /// The thesis's rule: water geometry where the mesh resolves the river, painted elsewhere.
@@ -59,6 +59,22 @@ pub enum WaterMode {
     Geometry,
     /// Always paint rivers in the fragment shader (sea water stays geometry).
     Painted,
+}
+
+impl crate::named::Named for WaterMode {
+    const ALL: &'static [(&'static str, Self)] = &[
+        ("auto", Self::Auto),
+        ("geometry", Self::Geometry),
+        ("painted", Self::Painted),
+    ];
+}
+
+impl crate::named::Named for ViewMode {
+    const ALL: &'static [(&'static str, Self)] = &[
+        ("shaded", Self::Shaded),
+        ("lod", Self::Lod),
+        ("painted-red", Self::PaintedRed),
+    ];
 }
 
 impl WaterMode {
@@ -76,7 +92,7 @@ impl WaterMode {
 const COLOUR_BAND_MOUNTAIN_HEIGHT: f32 = 16.0;
 
 /// What the fragment shader shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ViewMode {
     Shaded,
