@@ -4,6 +4,20 @@
 
 use std::process::Command;
 
+/// A small planet (seed 3, base lattice 65, levels to 4) in `dir`, which is made: its configuration file.
+fn small_planet(dir: &std::path::Path) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let config = dir.join("small.xml");
+    std::fs::write(
+        &config,
+        "<planet><planet-attributes><base-resolution>65</base-resolution><master-seed>3</master-seed>\
+         </planet-attributes><rendering-attributes><max-level-of-detail>4</max-level-of-detail>\
+         </rendering-attributes></planet>",
+    )
+    .unwrap();
+    config
+}
+
 #[test]
 fn viewer_runs_60_frames_under_xvfb_and_its_screenshot_sidecar_renders_the_same_view() {
     let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
@@ -16,15 +30,7 @@ fn viewer_runs_60_frames_under_xvfb_and_its_screenshot_sidecar_renders_the_same_
         return;
     }
     let dir = std::env::temp_dir().join(format!("riverplanet-viewer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let config = dir.join("small.xml");
-    std::fs::write(
-        &config,
-        "<planet><planet-attributes><base-resolution>65</base-resolution><master-seed>3</master-seed>\
-         </planet-attributes><rendering-attributes><max-level-of-detail>4</max-level-of-detail>\
-         </rendering-attributes></planet>",
-    )
-    .unwrap();
+    let config = small_planet(&dir);
     let shot = dir.join("shot.png");
     let output = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 640x480x24"])
@@ -251,15 +257,7 @@ fn the_viewer_follows_synthetic_input_and_its_camera_stays_above_the_surface() {
         return;
     };
     let dir = std::env::temp_dir().join(format!("riverplanet-input-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let config = dir.join("small.xml");
-    std::fs::write(
-        &config,
-        "<planet><planet-attributes><base-resolution>65</base-resolution><master-seed>3</master-seed>\
-         </planet-attributes><rendering-attributes><max-level-of-detail>4</max-level-of-detail>\
-         </rendering-attributes></planet>",
-    )
-    .unwrap();
+    let config = small_planet(&dir);
     let record = dir.join("path.json");
     let mut viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
         .args(["view", "--size", "320x240", "--overlay", "off", "--config"])
@@ -392,15 +390,7 @@ fn the_overlay_shows_in_a_screenshot() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("riverplanet-overlay-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let config = dir.join("small.xml");
-    std::fs::write(
-        &config,
-        "<planet><planet-attributes><base-resolution>65</base-resolution><master-seed>3</master-seed>\
-         </planet-attributes><rendering-attributes><max-level-of-detail>4</max-level-of-detail>\
-         </rendering-attributes></planet>",
-    )
-    .unwrap();
+    let config = small_planet(&dir);
     let shoot = |overlay: &str| {
         let shot = dir.join(format!("overlay-{overlay}.png"));
         let output = Command::new("xvfb-run")
