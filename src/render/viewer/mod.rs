@@ -7,8 +7,11 @@
 //! planet), wheel zoom, C fly/orbit, Shift faster; M water mode,
 //! T atmosphere, F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
 //! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, H back to the start
-//! view, P screenshot, B bookmark the view, 1-9 back to a bookmark (viewer_paths.rs), Escape quit. The camera stays
+//! view, P screenshot (screenshot.rs), B bookmark the view, 1-9 back to a bookmark (viewer_paths.rs), Escape quit. The camera stays
 //! above the drawn surface (ground.rs).
+
+mod input;
+mod screenshot;
 
 use std::{collections::HashSet, path::PathBuf, time::Instant};
 
@@ -24,10 +27,10 @@ use winit::{
 };
 
 use super::{
-    frame::{FrameStats, Renderer, ViewMode},
+    frame::{FrameStats, Renderer},
     ground::Ground,
     overlay::{Overlay, ViewInfo},
-    target::{create_depth, Offscreen, DEPTH_FORMAT},
+    target::{create_depth, DEPTH_FORMAT},
     viewer_camera::{CameraMode, ViewerCamera},
     viewer_paths::ViewerPaths,
 };
@@ -155,13 +158,6 @@ pub fn run(
     }
 }
 
-fn screenshot_error(path: &std::path::Path, e: impl std::fmt::Display) -> ViewerError {
-    ViewerError::Screenshot {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    }
-}
-
 /// The least height above the drawn surface the camera keeps.
 const MIN_ALTITUDE: f64 = 0.3;
 
@@ -253,43 +249,6 @@ impl App<'_> {
         let ground = self.radius() + self.ground_height;
         if self.camera.position.length() < ground + MIN_ALTITUDE {
             self.camera.position = self.camera.radial() * (ground + MIN_ALTITUDE);
-        }
-    }
-
-    fn update_camera(&mut self, dt: f64) {
-        let fast =
-            self.keys.contains(&KeyCode::ShiftLeft) || self.keys.contains(&KeyCode::ShiftRight);
-        let speed = self.altitude().max(0.5) * if fast { 3.0 } else { 0.8 };
-        let (f, r, u) = (
-            self.camera.forward,
-            self.camera.right(),
-            self.camera.radial(),
-        );
-        let mut motion = DVec3::ZERO;
-        for (key, dir) in [
-            (KeyCode::KeyW, f),
-            (KeyCode::KeyS, -f),
-            (KeyCode::KeyD, r),
-            (KeyCode::KeyA, -r),
-            (KeyCode::KeyE, u),
-            (KeyCode::KeyQ, -u),
-        ] {
-            if self.keys.contains(&key) {
-                motion += dir;
-            }
-        }
-        self.camera.position += motion * speed * dt;
-        self.keep_above_ground();
-        let turn = 1.2 * dt;
-        for (key, yaw, pitch) in [
-            (KeyCode::ArrowLeft, -turn, 0.0),
-            (KeyCode::ArrowRight, turn, 0.0),
-            (KeyCode::ArrowUp, 0.0, turn),
-            (KeyCode::ArrowDown, 0.0, -turn),
-        ] {
-            if self.keys.contains(&key) {
-                self.camera.turn(yaw, pitch);
-            }
         }
     }
 
@@ -396,170 +355,6 @@ impl App<'_> {
             if renderer.is_some_and(|r| r.variant == KernelVariant::Simple) { " | simple kernel" } else { "" },
             if renderer.is_some_and(|r| r.lod_rule == LodRule::Distance) { " | Eq. 6.1" } else { "" },
         ));
-    }
-
-    /// The window's size, or the requested one before the window has a swapchain.
-    fn screenshot_size(&self) -> [u32; 2] {
-        self.swapchain
-            .as_ref()
-            .map_or(self.options.size, |s| [s.extent.width, s.extent.height])
-    }
-
-    /// Renders the current view offscreen at the window's size, writes it as PNG and beside it its JSON sidecar
-    /// (`ViewerCamera::sidecar`).
-    fn screenshot(&mut self, path: &std::path::Path) -> Result<(), ViewerError> {
-        let [w, h] = self.screenshot_size();
-        let camera = self.camera(w, h);
-        let Some(renderer) = &mut self.renderer else {
-            return Ok(());
-        };
-        let overlay = &mut self.overlay;
-        let target = Offscreen::with_format(self.ctx, w, h, SWAPCHAIN_FORMAT)?;
-        let result = (|| {
-            for _ in 0..50 {
-                // The overlay as shown (what you see is what you get; U hides it).
-                let mut draw_overlay = |rec: &mut crate::gpu::Recorder, extent| {
-                    if let Some(overlay) = overlay.as_mut() {
-                        if let Err(e) = overlay.record(rec, extent) {
-                            log::error!("{e}");
-                        }
-                    }
-                };
-                let stats = renderer.render_with_overlay(
-                    &camera,
-                    &target.target([0.02, 0.03, 0.06, 1.0]),
-                    (
-                        vk::ImageLayout::UNDEFINED,
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    ),
-                    (&[], &[]),
-                    Some(&mut draw_overlay),
-                )?;
-                if stats.pending_patches == 0 && stats.fallback_patches == 0 {
-                    break;
-                }
-            }
-            target.read(self.ctx)
-        })();
-        target.destroy(self.ctx);
-        let image = result?;
-        crate::export::files::save_image(&image, path).map_err(|e| screenshot_error(path, e))?;
-        let sidecar = path.with_extension("json");
-        let name = path
-            .file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-        let bookmark = self.camera.sidecar(
-            &name,
-            (self.world.seed, self.frames),
-            self.altitude(),
-            [w, h],
-            self.options.config.as_deref(),
-        );
-        let text =
-            serde_json::to_string_pretty(&bookmark).map_err(|e| screenshot_error(&sidecar, e))?;
-        crate::export::files::write_bytes(&sidecar, text.as_bytes())
-            .map_err(|e| screenshot_error(&sidecar, e))?;
-        println!(
-            "screenshot: {} (camera: {})",
-            path.display(),
-            sidecar.display()
-        );
-        Ok(())
-    }
-
-    /// P: a screenshot into the screenshot folder, named by seed and frame.
-    fn screenshot_into_folder(&mut self) -> Result<(), ViewerError> {
-        let dir = self.options.screenshots.clone();
-        std::fs::create_dir_all(&dir).map_err(|e| screenshot_error(&dir, e))?;
-        let path = dir.join(format!(
-            "riverplanet-seed{}-frame{}.png",
-            self.world.seed, self.frames
-        ));
-        self.screenshot(&path)
-    }
-
-    fn key(&mut self, event_loop: &ActiveEventLoop, code: KeyCode) {
-        let Some(renderer) = &mut self.renderer else {
-            return;
-        };
-        match code {
-            KeyCode::Escape => event_loop.exit(),
-            // Home: back to the start view, wherever the flight went.
-            KeyCode::KeyH => {
-                self.camera = home(&self.options, self.radius());
-                self.keep_above_ground();
-            }
-            KeyCode::KeyB => {
-                let altitude = self.altitude();
-                match self.paths.bookmark(&self.camera, altitude) {
-                    Ok(k) => println!("bookmark {k}: key {k} flies back here"),
-                    Err(e) => log::error!("cannot save the bookmark: {e}"),
-                }
-            }
-            KeyCode::Digit1
-            | KeyCode::Digit2
-            | KeyCode::Digit3
-            | KeyCode::Digit4
-            | KeyCode::Digit5
-            | KeyCode::Digit6
-            | KeyCode::Digit7
-            | KeyCode::Digit8
-            | KeyCode::Digit9 => {
-                let k = code as usize - KeyCode::Digit0 as usize;
-                if let Some(camera) = self.paths.recall(k, self.radius()) {
-                    self.camera = camera;
-                    self.keep_above_ground();
-                }
-            }
-            KeyCode::KeyC => {
-                self.camera.mode = match self.camera.mode {
-                    CameraMode::Fly => CameraMode::Orbit,
-                    CameraMode::Orbit => CameraMode::Fly,
-                }
-            }
-            KeyCode::KeyU => {
-                if let Some(overlay) = &mut self.overlay {
-                    overlay.visible = !overlay.visible;
-                }
-            }
-            KeyCode::KeyM => renderer.water_mode = renderer.water_mode.next(),
-            KeyCode::KeyT => renderer.atmosphere_on = !renderer.atmosphere_on,
-            KeyCode::KeyF => renderer.wireframe_on = !renderer.wireframe_on,
-            KeyCode::KeyL => {
-                renderer.view_mode = if renderer.view_mode == ViewMode::Lod {
-                    ViewMode::Shaded
-                } else {
-                    ViewMode::Lod
-                }
-            }
-            KeyCode::KeyR => {
-                renderer.view_mode = if renderer.view_mode == ViewMode::PaintedRed {
-                    ViewMode::Shaded
-                } else {
-                    ViewMode::PaintedRed
-                }
-            }
-            KeyCode::KeyZ => renderer.freeze_lod = !renderer.freeze_lod,
-            KeyCode::KeyO => renderer.morphing = !renderer.morphing,
-            KeyCode::KeyG => {
-                renderer.lod_rule = match renderer.lod_rule {
-                    LodRule::ScreenSpaceError => LodRule::Distance,
-                    LodRule::Distance => LodRule::ScreenSpaceError,
-                }
-            }
-            KeyCode::KeyK => {
-                renderer.variant = match renderer.variant {
-                    KernelVariant::Simple => KernelVariant::Tiled,
-                    KernelVariant::Tiled => KernelVariant::Simple,
-                }
-            }
-            KeyCode::KeyP => {
-                if let Err(e) = self.screenshot_into_folder() {
-                    self.fail(event_loop, e);
-                }
-            }
-            _ => {}
-        }
     }
 
     fn shutdown(&mut self) {
