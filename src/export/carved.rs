@@ -15,7 +15,7 @@ use crate::{
     kernel::KernelParams,
     planet::{cube::PatchId, cube::FACES, detail, heights::FaceLattice, Planet},
     river::network::RiverNetwork,
-    runtime::surface::{carve_patch, CarvedPatch},
+    runtime::surface::{bilinear, carve_patch, CarvedPatch},
 };
 
 /// The finest level an export computes: level 7 holds 6 x 4097 x 4097 heights (403 MB of f32, about three times
@@ -86,17 +86,6 @@ pub fn carved_terrain(
 pub fn height_towards(lattice: &FaceLattice, d: glam::DVec3) -> f32 {
     let (face, u, v) = crate::planet::cube::face_of(d);
     let cells = lattice.cells as f64;
-    let x = ((u + 1.0) * 0.5 * cells).clamp(0.0, cells);
-    let y = ((v + 1.0) * 0.5 * cells).clamp(0.0, cells);
-    let (i, j) = (
-        (x.floor() as u32).min(lattice.cells - 1),
-        (y.floor() as u32).min(lattice.cells - 1),
-    );
-    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
-    let row = |j| {
-        let a = lattice.get(face, i, j);
-        a + (lattice.get(face, i + 1, j) - a) * fx
-    };
-    let (a, b) = (row(j), row(j + 1));
-    a + (b - a) * fy
+    let grid = ((u + 1.0) * 0.5 * cells, (v + 1.0) * 0.5 * cells);
+    bilinear(lattice.cells, grid, |i, j| lattice.get(face, i, j))
 }

@@ -108,14 +108,11 @@ impl CarvedPatch {
         let (_, u, v) = face_of_on(patch.face as usize, d);
         let (u0, v0) = patch.origin();
         let cells = (n - 1) as f64;
-        let s = ((u - u0) / patch.size() * cells).clamp(0.0, cells);
-        let t = ((v - v0) / patch.size() * cells).clamp(0.0, cells);
-        let (i, j) = ((s as u32).min(n - 2), (t as u32).min(n - 2));
-        let (fs, ft) = ((s - i as f64) as f32, (t - j as f64) as f32);
-        let at = |i: u32, j: u32| values[(j * n + i) as usize];
-        let bottom = at(i, j) + (at(i + 1, j) - at(i, j)) * fs;
-        let top = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * fs;
-        bottom + (top - bottom) * ft
+        let grid = (
+            (u - u0) / patch.size() * cells,
+            (v - v0) / patch.size() * cells,
+        );
+        bilinear(n - 1, grid, |i, j| values[(j * n + i) as usize])
     }
 
     /// The height of what is drawn at direction `d`: the water where the vertices around it are in a river's
@@ -129,4 +126,16 @@ impl CarvedPatch {
             terrain
         }
     }
+}
+
+/// Bilinear interpolation on a grid of `cells` x `cells` cells whose point (i, j) holds `value(i, j)`, at grid
+/// coordinates `(x, y)` (clamped to the grid).
+pub fn bilinear(cells: u32, (x, y): (f64, f64), value: impl Fn(u32, u32) -> f32) -> f32 {
+    let limit = cells as f64;
+    let (x, y) = (x.clamp(0.0, limit), y.clamp(0.0, limit));
+    let (i, j) = ((x as u32).min(cells - 1), (y as u32).min(cells - 1));
+    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
+    let bottom = value(i, j) + (value(i + 1, j) - value(i, j)) * fx;
+    let top = value(i, j + 1) + (value(i + 1, j + 1) - value(i, j + 1)) * fx;
+    bottom + (top - bottom) * fy
 }

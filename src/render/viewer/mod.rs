@@ -264,6 +264,12 @@ impl App<'_> {
             return Ok(());
         }; // minimised
         let camera = self.camera(extent.width, extent.height);
+        let info = ViewInfo {
+            seed: self.world.seed,
+            altitude: self.altitude(),
+            mode: self.camera.mode,
+            frame_ms: self.smoothed_ms,
+        };
         let (Some(swapchain), Some(depth), Some(renderer)) =
             (&mut self.swapchain, &self.depth, &mut self.renderer)
         else {
@@ -280,12 +286,6 @@ impl App<'_> {
             depth_view: depth.view,
             extent,
             clear_color: [0.02, 0.03, 0.06, 1.0],
-        };
-        let info = ViewInfo {
-            seed: self.world.seed,
-            altitude: self.camera.position.length() - self.world.planet.radius - self.ground_height,
-            mode: self.camera.mode,
-            frame_ms: self.smoothed_ms,
         };
         if let (Some(overlay), Some(window)) = (&mut self.overlay, &self.window) {
             overlay.prepare(self.ctx, window, renderer, (&info, &self.last_stats))?;
