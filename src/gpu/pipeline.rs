@@ -246,6 +246,9 @@ pub struct GraphicsDesc<'a> {
     pub depth_test: bool,
     pub blend: Blend,
     pub wireframe: bool,
+    /// Cull triangles seen from behind (counter-clockwise in framebuffer coordinates is the front): for closed
+    /// surfaces, whose back faces are always hidden.
+    pub cull_back_faces: bool,
 }
 
 /// How a graphics pipeline's colour output combines with the attachment.
@@ -322,7 +325,12 @@ impl GraphicsPipeline {
                 } else {
                     vk::PolygonMode::FILL
                 })
-                .cull_mode(vk::CullModeFlags::NONE)
+                .cull_mode(if desc.cull_back_faces {
+                    vk::CullModeFlags::BACK
+                } else {
+                    vk::CullModeFlags::NONE
+                })
+                .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
                 .line_width(1.0);
             let multisample = vk::PipelineMultisampleStateCreateInfo::default()
                 .rasterization_samples(vk::SampleCountFlags::TYPE_1);

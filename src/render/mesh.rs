@@ -53,31 +53,56 @@ pub fn patch_mesh(n: u32) -> PatchMesh {
         }
     }
     for k in 0..n - 1 {
-        // (first vertex, second vertex, skirt edge, list, quadrants it belongs to)
+        // (first vertex, second vertex, skirt edge, list, the quadrants it belongs to with whether its winding is
+        // reversed there). As built, a segment along +i faces +j and one along +j faces -i; every skirt must face
+        // away from its quadrant, so that back faces can be culled (the surface with its skirts is closed).
         let segments = [
-            (grid(k, 0), grid(k + 1, 0), 0, 1, vec![half(k)]),
-            (grid(k, n - 1), grid(k + 1, n - 1), 1, 1, vec![half(k) | 2]),
-            (grid(0, k), grid(0, k + 1), 2, 1, vec![half(k) << 1]),
+            (grid(k, 0), grid(k + 1, 0), 0, 1, vec![(half(k), true)]),
+            (
+                grid(k, n - 1),
+                grid(k + 1, n - 1),
+                1,
+                1,
+                vec![(half(k) | 2, false)],
+            ),
+            (
+                grid(0, k),
+                grid(0, k + 1),
+                2,
+                1,
+                vec![(half(k) << 1, false)],
+            ),
             (
                 grid(n - 1, k),
                 grid(n - 1, k + 1),
                 3,
                 1,
-                vec![1 | half(k) << 1],
+                vec![(1 | half(k) << 1, true)],
             ),
             (
                 grid(m, k),
                 grid(m, k + 1),
                 4,
                 2,
-                vec![half(k) << 1, 1 | half(k) << 1],
+                vec![(half(k) << 1, true), (1 | half(k) << 1, false)],
             ),
-            (grid(k, m), grid(k + 1, m), 5, 3, vec![half(k), half(k) | 2]),
+            (
+                grid(k, m),
+                grid(k + 1, m),
+                5,
+                3,
+                vec![(half(k), false), (half(k) | 2, true)],
+            ),
         ];
         for (a, b, edge, list, quadrants) in segments {
             let (sa, sb) = (skirt(edge, k), skirt(edge, k + 1));
-            for q in quadrants {
-                lists[q as usize][list].extend_from_slice(&[a, b, sb, a, sb, sa]);
+            for (q, reversed) in quadrants {
+                let triangles = if reversed {
+                    [b, a, sa, b, sa, sb]
+                } else {
+                    [a, b, sb, a, sb, sa]
+                };
+                lists[q as usize][list].extend_from_slice(&triangles);
             }
         }
     }
@@ -186,6 +211,60 @@ mod tests {
                     let quadrant = ((ci * 2 >= 3 * (n - 1)) as usize)
                         | (((cj * 2 >= 3 * (n - 1)) as usize) << 1);
                     assert_eq!(quadrant, q, "triangle with vertex {v}");
+                }
+            }
+        }
+    }
+
+    /// The terrain pass culls back faces: every triangle must face outwards, grid cells up (counter-clockwise
+    /// seen from outside, i x j = up) and skirts away from their quadrant, or a crack would show through.
+    #[test]
+    fn every_triangle_faces_outwards() {
+        let n = 33;
+        let mesh = patch_mesh(n);
+        // Grid vertices at (i, j, 0), skirt vertices below their edge's grid points at z = -1.
+        let m = (n - 1) / 2;
+        let position = |v: u32| -> [f64; 3] {
+            if v < n * n {
+                return [(v % n) as f64, (v / n) as f64, 0.0];
+            }
+            let (edge, k) = ((v - n * n) / n, ((v - n * n) % n) as f64);
+            let (i, j) = match edge {
+                0 => (k, 0.0),
+                1 => (k, (n - 1) as f64),
+                2 => (0.0, k),
+                3 => ((n - 1) as f64, k),
+                4 => (m as f64, k),
+                _ => (k, m as f64),
+            };
+            [i, j, -1.0]
+        };
+        for (q, quadrant) in mesh.quadrants.iter().enumerate() {
+            let centre = [
+                (m as f64) * (0.5 + (q & 1) as f64),
+                (m as f64) * (0.5 + (q >> 1) as f64),
+            ];
+            let range = quadrant.core.start as usize..quadrant.across[1].end as usize;
+            for tri in mesh.indices[range].chunks(3) {
+                let [a, b, c] = [0, 1, 2].map(|k| position(tri[k]));
+                let (e, f) = (
+                    [0, 1, 2].map(|k| b[k] - a[k]),
+                    [0, 1, 2].map(|k| c[k] - a[k]),
+                );
+                let normal = [
+                    e[1] * f[2] - e[2] * f[1],
+                    e[2] * f[0] - e[0] * f[2],
+                    e[0] * f[1] - e[1] * f[0],
+                ];
+                if tri.iter().all(|&v| v < n * n) {
+                    assert!(normal[2] > 0.0, "grid triangle {tri:?} faces down");
+                } else {
+                    let middle = [0, 1].map(|k| (a[k] + b[k] + c[k]) / 3.0 - centre[k]);
+                    let away = normal[0] * middle[0] + normal[1] * middle[1];
+                    assert!(
+                        away > 0.0,
+                        "skirt triangle {tri:?} of quadrant {q} faces inwards"
+                    );
                 }
             }
         }

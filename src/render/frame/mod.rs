@@ -265,8 +265,8 @@ impl<'w> Renderer<'w> {
         })?;
         let layouts = [bindless.layout, instance_layout.layout];
         let vertex_cache = vertex_cache::VertexCache::new(ctx, &layouts)?;
-        // The terrain is drawn per quadrant without a geometry shader; the water pass has the geometry shader that
-        // spawns water triangles (docs/rendering.md).
+        // The terrain is drawn per quadrant without a geometry shader, back faces culled; the water pass has the
+        // geometry shader that spawns water triangles (docs/rendering.md).
         let pipeline = |name: &str, water: bool, wireframe: bool| {
             GraphicsPipeline::new(
                 ctx,
@@ -288,6 +288,9 @@ impl<'w> Renderer<'w> {
                     depth_test: true,
                     blend: if water { Blend::Alpha } else { Blend::None },
                     wireframe,
+                    // The terrain with its skirts is closed (render/mesh.rs); the water's geometry shader emits
+                    // triangles in either winding.
+                    cull_back_faces: !water,
                 },
             )
         };

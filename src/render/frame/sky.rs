@@ -103,6 +103,7 @@ impl Sky {
                 depth_test: true,
                 blend: Blend::Transmit,
                 wireframe: false,
+                cull_back_faces: false,
             },
         )?;
         Ok(Self {
