@@ -8,7 +8,7 @@ use riverplanet::{
     rng::Rng,
     runtime::{
         camera::Camera,
-        cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
+        cull::{beyond_horizon, visible_quadrants, Frustum, HeightRange},
         lod::{refines, select, LodParams, Selected},
     },
 };
@@ -157,12 +157,13 @@ fn covers(s: &Selected, d: DVec3) -> bool {
 }
 
 #[test]
-fn no_patch_with_a_visible_pixel_is_culled() {
+fn no_quadrant_with_a_visible_pixel_is_culled() {
     let range = HeightRange {
         min: -6.0,
         max: 16.5,
     };
     let mut rng = Rng::new(3, &[]);
+    let (mut culled_somewhere, mut hits) = (false, 0);
     for _ in 0..30 {
         let camera = random_camera(&mut rng);
         // Look at a random point of the visible side, with a random field of view.
@@ -181,12 +182,9 @@ fn no_patch_with_a_visible_pixel_is_culled() {
         let frustum = Frustum::from_matrix(clip);
         let inverse = clip.inverse();
         let selected = select(camera, &params(6));
-        let visible: Vec<&Selected> = selected
+        let visible: Vec<Selected> = selected
             .iter()
-            .filter(|s| {
-                let (c, r) = bounding_sphere(s.patch, RADIUS, range);
-                !beyond_horizon(s.patch, camera, RADIUS, range) && frustum.touches_sphere(c, r)
-            })
+            .filter_map(|s| visible_quadrants(s, camera, &frustum, RADIUS, range))
             .collect();
         for py in 0..24 {
             for px in 0..32 {
@@ -211,18 +209,24 @@ fn no_patch_with_a_visible_pixel_is_culled() {
                     continue;
                 }
                 let hit = (near + dir * t).normalize();
-                let owner = selected
-                    .iter()
-                    .find(|s| covers(s, hit))
-                    .expect("every direction is covered");
+                hits += 1;
                 assert!(
-                    visible.iter().any(|v| v.patch == owner.patch),
-                    "camera {camera}: patch {:?} covers pixel ({px}, {py}) but was culled",
-                    owner.patch
+                    selected.iter().any(|s| covers(s, hit)),
+                    "every direction is covered"
+                );
+                assert!(
+                    visible.iter().any(|v| covers(v, hit)),
+                    "camera {camera}: the quadrant at pixel ({px}, {py}) was culled"
                 );
             }
         }
+        // Culling per quadrant must cull: a view of part of the planet leaves quadrants out.
+        let drawn: u32 = visible.iter().map(|v| v.quadrants.count_ones()).sum();
+        let selectable: u32 = selected.iter().map(|s| s.quadrants.count_ones()).sum();
+        culled_somewhere |= drawn < selectable;
     }
+    assert!(hits > 1000, "the cameras see the planet ({hits} pixels)");
+    assert!(culled_somewhere, "no quadrant was ever culled");
 }
 
 #[test]

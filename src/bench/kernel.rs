@@ -18,7 +18,7 @@ use crate::{
     planet::cube::PatchId,
     river::samples::{patch_samples, PatchFrame, PatchSamples},
     runtime::{
-        cull::{beyond_horizon, bounding_sphere, Frustum, HeightRange},
+        cull::{visible_quadrants, Frustum, HeightRange},
         lod::{select, LodParams, Selected},
     },
     world::World,
@@ -123,10 +123,7 @@ pub fn flight_patches(
         let camera = flight.camera(world, frame);
         let frustum = Frustum::from_matrix(camera.clip());
         for s in select(camera.position) {
-            let (c, r) = bounding_sphere(s.patch, radius, heights);
-            if beyond_horizon(s.patch, camera.position, radius, heights)
-                || !frustum.touches_sphere(c, r)
-            {
+            if visible_quadrants(&s, camera.position, &frustum, radius, heights).is_none() {
                 continue;
             }
             if !seen.insert(s.patch) {

@@ -1,9 +1,11 @@
 //! Discarding patches the camera cannot see (Section 6.2.2): those beyond the horizon (the thesis's back-facing
 //! test, made conservative for terrain height) and those outside the view frustum. Both tests bound every point
-//! a patch can place on screen (terrain included), so no patch with a visible pixel is culled.
+//! a patch can place on screen (terrain included), so no patch with a visible pixel is culled. Beyond the thesis,
+//! which culls whole patches, the tests run per quadrant: a patch at the edge of the view draws only what shows.
 
 use glam::{DMat4, DVec3, DVec4};
 
+use super::lod::Selected;
 use crate::planet::cube::{angle, PatchId};
 
 /// The six planes of a view frustum, inward normals, as (normal, distance): inside when `n . p + d >= 0`.
@@ -85,4 +87,28 @@ pub fn beyond_horizon(patch: PatchId, camera: DVec3, radius: f64, range: HeightR
     let nearest = (angle(patch.center(), camera) - patch.cap_angle()).max(0.0);
     let horizon = (low / distance).acos() + (low / high).min(1.0).acos();
     nearest > horizon
+}
+
+/// `selected` less the quadrants the camera at `camera` cannot see through `frustum`, every point of the patch
+/// lying between the heights of `range`; `None` when no quadrant shows.
+pub fn visible_quadrants(
+    selected: &Selected,
+    camera: DVec3,
+    frustum: &Frustum,
+    radius: f64,
+    range: HeightRange,
+) -> Option<Selected> {
+    let seen = |q: &u32| {
+        let quadrant = selected.patch.child(*q);
+        let (centre, r) = bounding_sphere(quadrant, radius, range);
+        !beyond_horizon(quadrant, camera, radius, range) && frustum.touches_sphere(centre, r)
+    };
+    let quadrants = (0..4)
+        .filter(|q| selected.quadrants & (1 << q) != 0)
+        .filter(seen)
+        .fold(0, |mask, q| mask | 1 << q);
+    (quadrants != 0).then_some(Selected {
+        patch: selected.patch,
+        quadrants,
+    })
 }

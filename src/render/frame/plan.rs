@@ -13,7 +13,7 @@ use crate::{
     refine::with_ancestors,
     runtime::{
         camera::Camera,
-        cull::{beyond_horizon, bounding_sphere, Frustum},
+        cull::{visible_quadrants, Frustum, HeightRange},
         lod::{select, select_nearest, surface_bounds, LodParams, Selected},
     },
 };
@@ -40,8 +40,23 @@ impl Renderer<'_> {
         }
     }
 
-    /// The patches to draw: the level of detail's selection (or the frozen one), less those beyond the horizon or
-    /// outside the frustum.
+    /// The heights between which `patch`'s surface lies (base terrain, river beds and the sea), from its own data
+    /// or its nearest resident ancestor's (`lod::surface_bounds`).
+    fn surface_bounds(&self, patch: PatchId) -> (f64, f64) {
+        let nearest = self
+            .cache
+            .nearest_resident(patch)
+            .map(|(q, data)| (q.level, data.surface_range()));
+        surface_bounds(
+            self.planet,
+            self.config.river.basin_depth as f64,
+            patch,
+            nearest,
+        )
+    }
+
+    /// The patches to draw: the level of detail's selection (or the frozen one), less the quadrants beyond the
+    /// horizon or outside the frustum.
     pub(super) fn visible_patches(
         &mut self,
         camera: &Camera,
@@ -54,31 +69,24 @@ impl Renderer<'_> {
         let selected = match (&self.frozen, self.freeze_lod) {
             (Some(frozen), true) => frozen.clone(),
             _ if self.morphing => {
-                let depth = self.config.river.basin_depth as f64;
-                let cache = &self.cache;
-                select_nearest(camera.position, &self.lod, &|p| {
-                    let nearest = cache
-                        .nearest_resident(p)
-                        .map(|(q, data)| (q.level, data.surface_range()));
-                    surface_bounds(self.planet, depth, p, nearest)
-                })
+                select_nearest(camera.position, &self.lod, &|p| self.surface_bounds(p))
             }
             _ => select(camera.position, &self.lod),
         };
         self.frozen = Some(selected.clone());
         cpu.insert("lod".to_string(), ms_since(t));
 
-        // Section 6.2.2: horizon and frustum culling.
+        // Section 6.2.2: horizon and frustum culling, here per quadrant (beyond the thesis's per patch) within the
+        // patch's own heights: a quadrant the camera cannot see is not drawn, a patch with none left not at all.
         let t = Instant::now();
         let frustum = Frustum::from_matrix(camera.clip());
         let visible: Vec<Selected> = selected
             .iter()
-            .filter(|s| {
-                let (centre, r) = bounding_sphere(s.patch, radius, self.heights);
-                !beyond_horizon(s.patch, camera.position, radius, self.heights)
-                    && frustum.touches_sphere(centre, r)
+            .filter_map(|s| {
+                let (min, max) = self.surface_bounds(s.patch);
+                let range = HeightRange { min, max };
+                visible_quadrants(s, camera.position, &frustum, radius, range)
             })
-            .copied()
             .collect();
         cpu.insert("cull".to_string(), ms_since(t));
         stats.selected_patches = selected.len();
