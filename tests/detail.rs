@@ -221,3 +221,63 @@ fn gpu_refinement_equals_the_cpu_reference_bit_for_bit() {
     refiner.destroy(ctx);
     bindless.destroy(ctx);
 }
+
+/// The screen-space error's bound (`Planet::geometric_error`, beyond the thesis): no vertex of the finest drawn
+/// level stands further from a coarser patch's surface (bilinear between its vertices) than that level's error,
+/// and the bound is not vacuous (some level comes within half of it).
+#[test]
+fn geometric_errors_bound_the_finest_drawn_surface() {
+    let planet = planet(6, 3);
+    let n = planet.vertices as i64;
+    let finest = planet.max_level as u8;
+    let mut rng = riverplanet::rng::Rng::new(9, &[]);
+    let mut tightest = 0.0f64;
+    for level in 0..finest {
+        let count = 1u64 << level;
+        let scale = 1u32 << (finest - level);
+        let mut worst = 0.0f64;
+        for _ in 0..200 {
+            let coarse = PatchId {
+                face: rng.below(FACES as u64) as u8,
+                level,
+                x: rng.below(count) as u32,
+                y: rng.below(count) as u32,
+            };
+            let fine = PatchId {
+                face: coarse.face,
+                level: finest,
+                x: coarse.x * scale + rng.below(scale as u64) as u32,
+                y: coarse.y * scale + rng.below(scale as u64) as u32,
+            };
+            let (c, f) = (planet.patch_heights(coarse), planet.patch_heights(fine));
+            for j in 0..n {
+                for i in 0..n {
+                    // The fine vertex in the coarse patch's vertex coordinates.
+                    let at = |offset: u32, k: i64| {
+                        (offset as f64 * (n - 1) as f64 + k as f64) / scale as f64
+                    };
+                    let (x, y) = (
+                        at(fine.x - coarse.x * scale, i),
+                        at(fine.y - coarse.y * scale, j),
+                    );
+                    let (ci, cj) = ((x as i64).min(n - 2), (y as i64).min(n - 2));
+                    let (fx, fy) = (x - ci as f64, y - cj as f64);
+                    let h = |di: i64, dj: i64| c.get(ci + di, cj + dj) as f64;
+                    let bilinear = (h(0, 0) * (1.0 - fx) + h(1, 0) * fx) * (1.0 - fy)
+                        + (h(0, 1) * (1.0 - fx) + h(1, 1) * fx) * fy;
+                    worst = worst.max((f.get(i, j) as f64 - bilinear).abs());
+                }
+            }
+        }
+        let bound = planet.geometric_error(level as u32);
+        assert!(
+            worst <= bound,
+            "level {level}: a level-{finest} vertex stands {worst} from the surface, error {bound}"
+        );
+        tightest = tightest.max(worst / bound);
+    }
+    assert!(
+        tightest > 0.5,
+        "the errors are at least twice too large ({tightest})"
+    );
+}
