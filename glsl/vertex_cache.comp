@@ -5,7 +5,8 @@
 // the drawn patches first). On the way it finds the drawn quadrants with water, the only ones the water pass
 // draws: its four indirect draws per patch start with no instance, and a quadrant that has a vertex in a river's
 // basin (unless rivers are painted) or below sea level gets one. The geometry shader still decides per triangle
-// (Section 8.4); a dry quadrant would emit nothing.
+// (Section 8.4); a dry quadrant would emit nothing. Vertices of quadrants the patch does not draw (covered by finer
+// patches or culled) are skipped.
 #define VERTEX_CACHE_WRITER
 #include "terrain_vertex.glsl"
 
@@ -45,7 +46,8 @@ void main() {
     int entry = cacheIndex(p);
     if (gl_LocalInvocationIndex == 0) wetQuadrants = 0u;
     barrier();
-    if (id < n * n) {
+    // Only the vertices of drawn quadrants' cells (culled quadrants are not drawn, their skirts hang from them).
+    if (id < n * n && (quadrantsAround(ivec2(id % n, id / n), n) & uint(p.slots.z)) != 0u) {
         TerrainVertex v = terrainVertex(p, id);
         storeVertex(uint(entry * n * n + id), v, shadeVertex(p, v, true));
         bool river = waterMode() != WATER_PAINTED && abs(v.surface.z) < v.surface.w;
