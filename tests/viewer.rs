@@ -445,3 +445,63 @@ fn the_overlay_shows_in_a_screenshot() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// SIGTERM (and SIGINT) end the viewer as Escape does: the requested screenshot and the camera path are written,
+/// the device released (no leak warnings), exit code 0.
+#[test]
+fn sigterm_stops_the_viewer_cleanly_with_its_screenshot() {
+    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
+    let Some(xvfb) = Xvfb::start() else {
+        assert!(
+            !required,
+            "RIVERPLANET_REQUIRE_GPU=1 but Xvfb does not start (tools/setup installs xvfb)"
+        );
+        eprintln!("skipping: Xvfb does not start");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("riverplanet-sigterm-{}", std::process::id()));
+    let config = small_planet(&dir);
+    let (shot, record) = (dir.join("stopped.png"), dir.join("path.json"));
+    let viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
+        .args(["view", "--size", "320x240", "--config"])
+        .arg(&config)
+        .arg("--screenshot")
+        .arg(&shot)
+        .arg("--record")
+        .arg(&record)
+        .env("DISPLAY", &xvfb.display)
+        .env("RIVERPLANET_VALIDATION", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let input = Input::connect(&xvfb.display);
+    let started = std::time::Instant::now();
+    while input.shown_window().is_none() {
+        assert!(started.elapsed().as_secs() < 60, "no window after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-TERM", &viewer.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let output = viewer.wait_with_output().unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr),
+    );
+    assert!(
+        output.status.success(),
+        "viewer failed after SIGTERM: {stderr}"
+    );
+    assert!(stdout.contains("SIGTERM: stopping"), "{stdout}");
+    assert!(!stderr.to_lowercase().contains("leak"), "{stderr}");
+    let image = image::open(&shot).unwrap().to_rgba8();
+    assert_eq!(image.dimensions(), (320, 240));
+    assert!(shot.with_extension("json").exists(), "no camera sidecar");
+    let path = riverplanet::runtime::camera_path::CameraPath::load(&record).unwrap();
+    assert!(!path.frames.is_empty(), "no frame recorded");
+    let _ = std::fs::remove_dir_all(&dir);
+}
