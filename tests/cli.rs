@@ -770,3 +770,40 @@ fn a_recorded_camera_path_replays_in_render_and_bench_flight() {
     assert_eq!(report["recorded_path"], true);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Lavapipe with 128-bit vectors (`LP_NATIVE_VECTOR_WIDTH=128`, as on CPUs without AVX2) renders the same image:
+/// it used to abort with heap corruption on the first frame (docs/rendering.md, "Vertex capture").
+#[test]
+fn lavapipe_with_128_bit_vectors_renders_the_same_image() {
+    let dir = temp_dir("vector-width");
+    let render = |width: Option<&str>, name: &str| {
+        let mut command = riverplanet();
+        command.args([
+            "render", "--seed", "1", "--preset", "orbit", "--size", "160x90", "--out",
+        ]);
+        command.arg(dir.join(name));
+        if let Some(w) = width {
+            command.env("LP_NATIVE_VECTOR_WIDTH", w);
+        }
+        let out = command.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {:?} {}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        image::open(dir.join(name)).unwrap().to_rgba8()
+    };
+    let (narrow, default) = (render(Some("128"), "128.png"), render(None, "default.png"));
+    let differing = narrow
+        .pixels()
+        .zip(default.pixels())
+        .filter(|(a, b)| a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > 8))
+        .count();
+    assert!(
+        differing * 100 < narrow.len() / 4,
+        "{differing} of {} pixels differ",
+        narrow.len() / 4
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
