@@ -8,18 +8,13 @@
 #define TERRAIN_WRITER
 #include "terrain_interface.glsl"
 
-// 1 in the pipeline that captures vertices (tests). A specialisation, not a branch on a push constant: the draw
-// pipelines have no store, and lavapipe with 128-bit vectors corrupted its heap on the store behind a branch no
-// vertex took (docs/rendering.md, "Vertex capture").
-layout(constant_id = 1) const uint CAPTURE = 0;
-
 void main() {
     PatchInstance p = instances[gl_InstanceIndex];
     TerrainVertex v;
     VertexShading shading;
     meshVertex(p, true, v, shading);
 
-    if (CAPTURE == 1) {
+    if (frame.extra.w > 0.5) {
         int n = int(frame.planet.y);
         captured[gl_InstanceIndex * (n * n + 6 * n) + gl_VertexIndex] = vec4(v.position, 1.0 + v.morph);
     }

@@ -13,7 +13,7 @@ layout(push_constant) uniform FramePush {
     vec4 planet;
     // x: the atmosphere's transmittance table slot, or -1 without atmosphere; y: time in seconds (the water's
     // flow); z: height unit of the colour bands (max-mountain-height / 16, so that Appendix A's planet, whose
-    // mountains are 16 high, is coloured as before); w: unused (0).
+    // mountains are 16 high, is coloured as before); w: 1 to capture vertices.
     vec4 extra;
     // xyz: the camera from the planet's centre; w: atmosphere-height.
     vec4 camera;
@@ -47,8 +47,8 @@ struct PatchInstance {
 const float DETAIL_PERIOD = 256.0;
 
 layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance instances[]; };
-// Where the terrain pass's capturing pipeline (terrain.vert with CAPTURE 1, for tests) puts every vertex: per instance
-// and mesh vertex, the camera-relative position and 1 + morph factor.
+// Where the terrain pass puts every vertex when frame.extra.w is 1 (tests): per instance and mesh vertex, the
+// camera-relative position and 1 + morph factor.
 layout(set = 1, binding = 1, std430) writeonly buffer Captured { vec4 captured[]; };
 
 // Every patch texture is a 2D array view: base heights (1 layer, with a one-texel border), river data (2 layers).

@@ -335,8 +335,6 @@ impl Renderer<'_> {
         let scope = self.frames.profiler().begin(rec, "terrain")?;
         let terrain = if self.wireframe_on {
             &self.wireframe
-        } else if self.capture_vertices {
-            &self.terrain_capture
         } else {
             &self.terrain
         };

@@ -171,8 +171,6 @@ pub struct Renderer<'w> {
     terrain: GraphicsPipeline,
     water: GraphicsPipeline,
     wireframe: GraphicsPipeline,
-    /// The terrain pipeline that also writes every vertex to the capture buffer (`capture_vertices`).
-    terrain_capture: GraphicsPipeline,
     /// The atmosphere's table and sky pass; `None` for a planet without air (`atmosphere-height` 0).
     sky: Option<sky::Sky>,
     instance_layout: BufferSetLayout,
@@ -269,7 +267,7 @@ impl<'w> Renderer<'w> {
         let vertex_cache = vertex_cache::VertexCache::new(ctx, &layouts)?;
         // The terrain is drawn per quadrant without a geometry shader, back faces culled; the water pass has the
         // geometry shader that spawns water triangles (docs/rendering.md).
-        let pipeline = |name: &str, water: bool, wireframe: bool, capture: bool| {
+        let pipeline = |name: &str, water: bool, wireframe: bool| {
             GraphicsPipeline::new(
                 ctx,
                 &GraphicsDesc {
@@ -283,7 +281,7 @@ impl<'w> Renderer<'w> {
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
                     push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                    specialization: &[water as u32, capture as u32],
+                    specialization: &[water as u32],
                     color_format,
                     depth_format,
                     depth_write: !water,
@@ -296,10 +294,9 @@ impl<'w> Renderer<'w> {
                 },
             )
         };
-        let terrain = pipeline("terrain", false, false, false)?;
-        let water = pipeline("water", true, false, false)?;
-        let wireframe = pipeline("terrain wireframe", false, true, false)?;
-        let terrain_capture = pipeline("terrain capturing vertices", false, false, true)?;
+        let terrain = pipeline("terrain", false, false)?;
+        let water = pipeline("water", true, false)?;
+        let wireframe = pipeline("terrain wireframe", false, true)?;
         let air = Atmosphere::new(
             planet.radius,
             planet.sea_level as f64,
@@ -341,7 +338,6 @@ impl<'w> Renderer<'w> {
             terrain,
             water,
             wireframe,
-            terrain_capture,
             sky,
             instance_layout,
             no_capture,
@@ -563,7 +559,6 @@ impl<'w> Renderer<'w> {
         self.terrain.destroy(ctx);
         self.water.destroy(ctx);
         self.wireframe.destroy(ctx);
-        self.terrain_capture.destroy(ctx);
         if let Some(sky) = self.sky {
             sky.destroy(ctx, &mut self.bindless);
         }

@@ -78,7 +78,7 @@ impl Renderer<'_> {
                 sky.map_or(-1.0, |s| s.slot()),
                 self.time,
                 self.config.planet.max_mountain_height / COLOUR_BAND_MOUNTAIN_HEIGHT,
-                0.0,
+                self.capture_vertices as u32 as f32,
             ],
             camera: [
                 camera.position.x as f32,
