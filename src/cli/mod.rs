@@ -172,7 +172,8 @@ pub struct RenderArgs {
     /// Seconds of animation: how far the water has flowed (a sequence of frames differs in this).
     #[arg(long, default_value_t = 0.0, value_parser = non_negative_number, allow_hyphen_values = true)]
     pub time: f64,
-    #[arg(long, value_parser = parse_vec3, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
+    /// The colour behind the planet (where no air is): red, green, blue in [0, 1].
+    #[arg(long, value_parser = parse_colour, default_value = "0.02,0.03,0.06", allow_hyphen_values = true)]
     pub clear_color: glam::DVec3,
     /// Frames to run at most while patch data streams in (the image is taken when nothing is pending).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u32).range(1..))]
@@ -241,7 +242,7 @@ pub struct PlanetArgs {
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Override master-seed.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub seed: Option<u32>,
 }
 
@@ -351,7 +352,7 @@ pub struct BenchPlanet {
     /// planet with the drainage model].
     #[arg(long)]
     pub config: Option<PathBuf>,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     pub seed: u32,
 }
 
@@ -473,7 +474,6 @@ fn positive_count(text: &str) -> Result<usize, String> {
     }
 }
 
-/// A finite number above 0.
 fn parse_lod_rule(text: &str) -> Result<LodRule, String> {
     match text {
         "screen-space-error" => Ok(LodRule::ScreenSpaceError),
@@ -500,6 +500,7 @@ fn non_negative_number(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A finite number above 0.
 fn positive_number(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
@@ -518,6 +519,14 @@ fn parse_vec3(text: &str) -> Result<glam::DVec3, String> {
         _ => Err(format!(
             "'{text}' is not three comma-separated numbers (e.g. 0,1200,3400)"
         )),
+    }
+}
+
+/// R,G,B: three numbers in [0, 1].
+fn parse_colour(text: &str) -> Result<glam::DVec3, String> {
+    match parse_vec3(text) {
+        Ok(c) if c.min_element() >= 0.0 && c.max_element() <= 1.0 => Ok(c),
+        _ => Err(format!("'{text}' is not R,G,B with each in [0, 1]")),
     }
 }
 
