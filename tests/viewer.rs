@@ -20,7 +20,7 @@ fn small_planet(dir: &std::path::Path) -> std::path::PathBuf {
 
 #[test]
 fn viewer_runs_60_frames_under_xvfb_and_its_screenshot_sidecar_renders_the_same_view() {
-    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
+    let required = gpu_required();
     if Command::new("xvfb-run").arg("--help").output().is_err() {
         assert!(
             !required,
@@ -106,6 +106,30 @@ fn viewer_runs_60_frames_under_xvfb_and_its_screenshot_sidecar_renders_the_same_
     std::fs::remove_dir_all(&dir).ok();
 }
 
+fn gpu_required() -> bool {
+    std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1")
+}
+
+/// `viewer` once its window shows (within a minute), or `None` to skip the test: it found no usable Vulkan device
+/// (only without RIVERPLANET_REQUIRE_GPU=1).
+fn shown(mut viewer: std::process::Child, input: &Input) -> Option<std::process::Child> {
+    let started = std::time::Instant::now();
+    while input.shown_window().is_none() {
+        if let Ok(Some(status)) = viewer.try_wait() {
+            let output = viewer.wait_with_output().unwrap();
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            if !gpu_required() && stderr.contains("no usable Vulkan") {
+                eprintln!("skipping: {stderr}");
+                return None;
+            }
+            panic!("the viewer ended ({status}) before showing a window: {stderr}");
+        }
+        assert!(started.elapsed().as_secs() < 60, "no window after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    Some(viewer)
+}
+
 /// An X server of the test's own (Xvfb on a free display), killed when dropped.
 struct Xvfb {
     display: String,
@@ -113,6 +137,19 @@ struct Xvfb {
 }
 
 impl Xvfb {
+    /// The test's X server, or `None` to skip the test (only without RIVERPLANET_REQUIRE_GPU=1).
+    fn for_test() -> Option<Self> {
+        let server = Self::start();
+        if server.is_none() {
+            assert!(
+                !gpu_required(),
+                "RIVERPLANET_REQUIRE_GPU=1 but Xvfb does not start (tools/setup installs xvfb)"
+            );
+            eprintln!("skipping: Xvfb does not start");
+        }
+        server
+    }
+
     fn start() -> Option<Self> {
         for number in 40 + std::process::id() % 200..400 {
             if std::path::Path::new(&format!("/tmp/.X11-unix/X{number}")).exists() {
@@ -247,19 +284,13 @@ const XK_ESCAPE: u32 = 0xff1b;
 /// below the camera, recomputed here (`render::ground`), the descent reaching it, and the last frame at home.
 #[test]
 fn the_viewer_follows_synthetic_input_and_its_camera_stays_above_the_surface() {
-    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
-    let Some(xvfb) = Xvfb::start() else {
-        assert!(
-            !required,
-            "RIVERPLANET_REQUIRE_GPU=1 but Xvfb does not start (tools/setup installs xvfb)"
-        );
-        eprintln!("skipping: Xvfb does not start");
+    let Some(xvfb) = Xvfb::for_test() else {
         return;
     };
     let dir = std::env::temp_dir().join(format!("riverplanet-input-{}", std::process::id()));
     let config = small_planet(&dir);
     let record = dir.join("path.json");
-    let mut viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
+    let viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
         .args(["view", "--size", "320x240", "--overlay", "off", "--config"])
         .arg(&config)
         .arg("--record")
@@ -273,20 +304,9 @@ fn the_viewer_follows_synthetic_input_and_its_camera_stays_above_the_surface() {
         .spawn()
         .unwrap();
     let input = Input::connect(&xvfb.display);
-    let started = std::time::Instant::now();
-    while input.shown_window().is_none() {
-        if let Ok(Some(status)) = viewer.try_wait() {
-            let output = viewer.wait_with_output().unwrap();
-            let stderr = String::from_utf8_lossy(&output.stderr);
-            if !required && stderr.contains("no usable Vulkan") {
-                eprintln!("skipping: {stderr}");
-                return;
-            }
-            panic!("the viewer ended ({status}) before showing a window: {stderr}");
-        }
-        assert!(started.elapsed().as_secs() < 60, "no window after a minute");
-        std::thread::sleep(std::time::Duration::from_millis(100));
-    }
+    let Some(mut viewer) = shown(viewer, &input) else {
+        return;
+    };
     let pause = |ms| std::thread::sleep(std::time::Duration::from_millis(ms));
     pause(1500);
     // Focus again now that the viewer listens (no window manager gives it).
@@ -381,7 +401,7 @@ fn the_viewer_follows_synthetic_input_and_its_camera_stays_above_the_surface() {
 /// in either run (the viewer fails on one).
 #[test]
 fn the_overlay_shows_in_a_screenshot() {
-    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
+    let required = gpu_required();
     if Command::new("xvfb-run").arg("--help").output().is_err() {
         assert!(
             !required,
@@ -450,13 +470,7 @@ fn the_overlay_shows_in_a_screenshot() {
 /// the device released (no leak warnings), exit code 0.
 #[test]
 fn sigterm_stops_the_viewer_cleanly_with_its_screenshot() {
-    let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
-    let Some(xvfb) = Xvfb::start() else {
-        assert!(
-            !required,
-            "RIVERPLANET_REQUIRE_GPU=1 but Xvfb does not start (tools/setup installs xvfb)"
-        );
-        eprintln!("skipping: Xvfb does not start");
+    let Some(xvfb) = Xvfb::for_test() else {
         return;
     };
     let dir = std::env::temp_dir().join(format!("riverplanet-sigterm-{}", std::process::id()));
@@ -476,11 +490,9 @@ fn sigterm_stops_the_viewer_cleanly_with_its_screenshot() {
         .spawn()
         .unwrap();
     let input = Input::connect(&xvfb.display);
-    let started = std::time::Instant::now();
-    while input.shown_window().is_none() {
-        assert!(started.elapsed().as_secs() < 60, "no window after a minute");
-        std::thread::sleep(std::time::Duration::from_millis(100));
-    }
+    let Some(viewer) = shown(viewer, &input) else {
+        return;
+    };
     std::thread::sleep(std::time::Duration::from_millis(1500));
     let killed = Command::new("kill")
         .args(["-TERM", &viewer.id().to_string()])
