@@ -110,6 +110,23 @@ fn gpu_required() -> bool {
     std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1")
 }
 
+/// `riverplanet view --size 320x240 ARGS` on `xvfb` with validation, and the input into its display, once its
+/// window shows; `None` to skip the test (as [`shown`]).
+fn start_viewer(xvfb: &Xvfb, args: &[&std::ffi::OsStr]) -> Option<(std::process::Child, Input)> {
+    let viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
+        .args(["view", "--size", "320x240"])
+        .args(args)
+        .env("DISPLAY", &xvfb.display)
+        .env("RIVERPLANET_VALIDATION", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let input = Input::connect(&xvfb.display);
+    let viewer = shown(viewer, &input)?;
+    Some((viewer, input))
+}
+
 /// `viewer` once its window shows (within a minute), or `None` to skip the test: it found no usable Vulkan device
 /// (only without RIVERPLANET_REQUIRE_GPU=1).
 fn shown(mut viewer: std::process::Child, input: &Input) -> Option<std::process::Child> {
@@ -290,21 +307,19 @@ fn the_viewer_follows_synthetic_input_and_its_camera_stays_above_the_surface() {
     let dir = std::env::temp_dir().join(format!("riverplanet-input-{}", std::process::id()));
     let config = small_planet(&dir);
     let record = dir.join("path.json");
-    let viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
-        .args(["view", "--size", "320x240", "--overlay", "off", "--config"])
-        .arg(&config)
-        .arg("--record")
-        .arg(&record)
-        .arg("--screenshots")
-        .arg(&dir)
-        .env("DISPLAY", &xvfb.display)
-        .env("RIVERPLANET_VALIDATION", "1")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let input = Input::connect(&xvfb.display);
-    let Some(mut viewer) = shown(viewer, &input) else {
+    let args = [
+        "--overlay".as_ref(),
+        "off".as_ref(),
+        "--config".as_ref(),
+        config.as_os_str(),
+    ];
+    let more = [
+        "--record".as_ref(),
+        record.as_os_str(),
+        "--screenshots".as_ref(),
+        dir.as_os_str(),
+    ];
+    let Some((mut viewer, input)) = start_viewer(&xvfb, &[&args[..], &more[..]].concat()) else {
         return;
     };
     let pause = |ms| std::thread::sleep(std::time::Duration::from_millis(ms));
@@ -476,21 +491,15 @@ fn sigterm_stops_the_viewer_cleanly_with_its_screenshot() {
     let dir = std::env::temp_dir().join(format!("riverplanet-sigterm-{}", std::process::id()));
     let config = small_planet(&dir);
     let (shot, record) = (dir.join("stopped.png"), dir.join("path.json"));
-    let viewer = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
-        .args(["view", "--size", "320x240", "--config"])
-        .arg(&config)
-        .arg("--screenshot")
-        .arg(&shot)
-        .arg("--record")
-        .arg(&record)
-        .env("DISPLAY", &xvfb.display)
-        .env("RIVERPLANET_VALIDATION", "1")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let input = Input::connect(&xvfb.display);
-    let Some(viewer) = shown(viewer, &input) else {
+    let args = [
+        "--config".as_ref(),
+        config.as_os_str(),
+        "--screenshot".as_ref(),
+        shot.as_os_str(),
+        "--record".as_ref(),
+        record.as_os_str(),
+    ];
+    let Some((viewer, _input)) = start_viewer(&xvfb, &args) else {
         return;
     };
     std::thread::sleep(std::time::Duration::from_millis(1500));
