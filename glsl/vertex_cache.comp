@@ -47,12 +47,13 @@ void main() {
     if (gl_LocalInvocationIndex == 0) wetQuadrants = 0u;
     barrier();
     // Only the vertices of drawn quadrants' cells (culled quadrants are not drawn, their skirts hang from them).
-    if (id < n * n && (quadrantsAround(ivec2(id % n, id / n), n) & uint(p.slots.z)) != 0u) {
+    uint around = id < n * n ? quadrantsAround(ivec2(id % n, id / n), n) : 0u;
+    if ((around & uint(p.slots.z)) != 0u) {
         TerrainVertex v = terrainVertex(p, id);
         storeVertex(uint(entry * n * n + id), v, shadeVertex(p, v, true));
         bool river = waterMode() != WATER_PAINTED && abs(v.surface.z) < v.surface.w;
         bool sea = v.surface.x < frame.sun.w;
-        if (river || sea) atomicOr(wetQuadrants, quadrantsAround(ivec2(v.grid), n));
+        if (river || sea) atomicOr(wetQuadrants, around);
     }
     barrier();
     uint q = gl_LocalInvocationIndex;
