@@ -4,7 +4,6 @@
 // width) or below sea level. River water the mesh is too coarse for is left to the fragment shader to paint.
 // (The terrain itself is drawn without a geometry shader, per quadrant: docs/rendering.md says why.)
 #include "terrain_common.glsl"
-#include "atmosphere.glsl"
 
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
@@ -13,10 +12,10 @@ layout(triangle_strip, max_vertices = 3) out;
 layout(location = 0) in vec4 vLocalInstance[];
 layout(location = 1) in vec4 vRiver[];
 layout(location = 2) in vec4 vDirectionEdge[];
-layout(location = 3) in vec4 vGridFlow[];
-layout(location = 4) in vec4 vRayleighSunR[];
-layout(location = 5) in vec4 vMieSunG[];
-layout(location = 6) in vec4 vTransmittanceSunB[];
+layout(location = 3) in vec4 vGridFlowXY[];
+layout(location = 4) in vec4 vInscatterSunR[];
+layout(location = 5) in vec4 vTransmittanceSunG[];
+layout(location = 6) in vec2 vSunBFlowZ[];
 
 #define TERRAIN_WRITER
 #include "terrain_interface.glsl"
@@ -25,7 +24,7 @@ void main() {
     if (vDirectionEdge[0].w >= 0.0 || vDirectionEdge[1].w >= 0.0 || vDirectionEdge[2].w >= 0.0) return;
     PatchInstance p = instances[int(vLocalInstance[0].w)];
     float middle = 0.5 * (frame.planet.y - 1.0);
-    vec2 middleOfTriangle = (vGridFlow[0].xy + vGridFlow[1].xy + vGridFlow[2].xy) / 3.0;
+    vec2 middleOfTriangle = (vGridFlowXY[0].xy + vGridFlowXY[1].xy + vGridFlowXY[2].xy) / 3.0;
     int quadrant = int(middleOfTriangle.x >= middle) | (int(middleOfTriangle.y >= middle) << 1);
     if ((p.slots.z & (1 << quadrant)) == 0) return;
 
@@ -56,9 +55,10 @@ void main() {
         s.river = vec4(vRiver[k].x, water, vRiver[k].z, vRiver[k].w);
         s.direction = direction;
         s.detail = p.detail.xyz + local;
-        s.flow = flowTangent(p, vGridFlow[k].zw, direction);
-        s.sunlight = vec3(vRayleighSunR[k].w, vMieSunG[k].w, vTransmittanceSunB[k].w);
-        s.air = Scattering(vRayleighSunR[k].xyz, vMieSunG[k].xyz, vTransmittanceSunB[k].xyz);
+        s.flow = vec3(vGridFlowXY[k].zw, vSunBFlowZ[k].y);
+        s.sunlight = vec3(vInscatterSunR[k].w, vTransmittanceSunG[k].w, vSunBFlowZ[k].x);
+        s.inscatter = vInscatterSunR[k].xyz;
+        s.transmittance = vTransmittanceSunG[k].xyz;
         // River water (not sea) is clipped to the basin in the fragment shader.
         s.riverWater = riverWater && !belowSea;
         s.level = p.centreRel.w;

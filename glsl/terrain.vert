@@ -26,9 +26,10 @@ void main() {
     s.direction = v.direction;
     // The patch centre's world position (mod the period, from f64) plus the vertex's small offset from it.
     s.detail = p.detail.xyz + v.local;
-    s.flow = flowTangent(p, v.flow, v.direction);
+    s.flow = v.flow;
     s.sunlight = shading.sunlight;
-    s.air = shading.air;
+    s.inscatter = shading.inscatter;
+    s.transmittance = shading.transmittance;
     s.riverWater = false;
     s.level = p.centreRel.w;
     s.spacing = p.centreDir.w;

@@ -53,11 +53,3 @@ layout(set = 1, binding = 1, std430) writeonly buffer Captured { vec4 captured[]
 
 // Every patch texture is a 2D array view: base heights (1 layer, with a one-texel border), river data (2 layers).
 layout(set = 0, binding = 1) uniform sampler2DArray patchTextures[];
-
-// The flow in the patch frame as a world tangent: the frame's axes are the face's u and v (the grid's i and j),
-// taken into the tangent plane.
-vec3 flowTangent(PatchInstance p, vec2 flow, vec3 direction) {
-    vec3 tangentU = normalize(p.axisU.xyz - direction * dot(p.axisU.xyz, direction));
-    vec3 tangentV = normalize(p.axisV.xyz - direction * dot(p.axisV.xyz, direction));
-    return flow.x * tangentU + flow.y * tangentV;
-}

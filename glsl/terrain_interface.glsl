@@ -1,7 +1,6 @@
 // What terrain.frag reads, written by terrain.vert (terrain pass) and terrain.geom (water pass), packed into eight
 // vec4 slots: lavapipe's draw module and triangle setup work per slot, per vertex and per triangle, on one thread
 // (docs/rendering.md, "The patch mesh and the shaders"). Writers define TERRAIN_WRITER before including it.
-// Needs atmosphere.glsl.
 
 #ifdef TERRAIN_WRITER
 #define TERRAIN_IO out
@@ -27,25 +26,22 @@ struct SurfaceVertex {
     vec3 detail;
     vec3 flow;            // the river's flow: a tangent, unit length where the samples agree
     vec3 sunlight;        // the sunlight that reaches the vertex
-    Scattering air;
+    vec3 inscatter;       // radiance the air scatters towards the eye
+    vec3 transmittance;   // what the air between the eye and the vertex lets through
     bool riverWater;
     float level;
     float spacing;
 };
 
 #ifdef TERRAIN_WRITER
-// The phase functions are applied per vertex: the angle between the view ray and the sun changes slowly across a
-// triangle, and a fragment is shaded several times as often as a vertex (one slot and two phase functions less
-// per fragment on lavapipe).
 void writeSurface(SurfaceVertex v) {
-    float c = dot(normalize(v.position), normalize(frame.sun.xyz));
     ioPositionFlowX = vec4(v.position, v.flow.x);
     ioNormalFlowY = vec4(v.normal, v.flow.y);
     ioRiver = v.river;
     ioDirectionFlowZ = vec4(v.direction, v.flow.z);
     ioDetailSunR = vec4(v.detail, v.sunlight.r);
-    ioInscatterSunG = vec4(inscattered(v.air.rayleigh, v.air.mie, c), v.sunlight.g);
-    ioTransmittanceSunB = vec4(v.air.transmittance, v.sunlight.b);
+    ioInscatterSunG = vec4(v.inscatter, v.sunlight.g);
+    ioTransmittanceSunB = vec4(v.transmittance, v.sunlight.b);
     ioFlat = vec3(v.riverWater ? 1.0 : 0.0, v.level, v.spacing);
 }
 #else

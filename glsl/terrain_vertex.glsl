@@ -84,13 +84,21 @@ vec3 positionAt(PatchInstance p, float height, vec3 offset) {
     return p.centreRel.xyz + p.centreDir.xyz * height + offset * (radius + height);
 }
 
+// The flow in the patch frame as a world tangent: the frame's axes are the face's u and v (the grid's i and j),
+// taken into the tangent plane.
+vec3 flowTangent(PatchInstance p, vec2 flow, vec3 direction) {
+    vec3 tangentU = normalize(p.axisU.xyz - direction * dot(p.axisU.xyz, direction));
+    vec3 tangentV = normalize(p.axisV.xyz - direction * dot(p.axisV.xyz, direction));
+    return flow.x * tangentU + flow.y * tangentV;
+}
+
 // One vertex of the patch mesh, before normals and atmosphere.
 struct TerrainVertex {
     vec3 position;   // camera-relative
     vec3 local;      // position - centreRel: small, the ground detail's coordinates build on it
     vec3 direction;  // unit direction from the planet centre
     vec4 surface;    // final height, water height, signed distance, river half width
-    vec2 flow;       // the water's flow in the patch frame
+    vec3 flow;       // the water's flow: a world tangent, unit length where the samples agree
     vec2 grid;       // (i, j) within the patch, unmorphed
     vec2 morphed;    // the grid position morphed towards the parent's mesh
     float morph;
@@ -98,13 +106,21 @@ struct TerrainVertex {
     int edge;        // -1 surface, 0-3 edge skirts, 4-5 midline skirts
 };
 
+// (a / n, a % n) for the mesh's small non-negative indices, through a float division: lavapipe runs an integer
+// division of a vector lane by lane. Exact while a < 2^20: the quotient's error stays far below 1 / (2n).
+ivec2 divMod(int a, int n) {
+    int q = int((float(a) + 0.5) / float(n));
+    return ivec2(q, a - q * n);
+}
+
 // The grid point of mesh vertex `id` (render/mesh.rs: the grid, then six skirts of n vertices) and its skirt.
 ivec2 meshGrid(int id, out int edge) {
     int n = int(frame.planet.y);
     edge = -1;
-    if (id < n * n) return ivec2(id % n, id / n);
-    edge = (id - n * n) / n;
-    int k = (id - n * n) % n;
+    if (id < n * n) return divMod(id, n).yx;
+    ivec2 skirt = divMod(id - n * n, n);
+    edge = skirt.x;
+    int k = skirt.y;
     int m = (n - 1) / 2;
     ivec2 along[6] = ivec2[](ivec2(k, 0), ivec2(k, n - 1), ivec2(0, k), ivec2(n - 1, k), ivec2(m, k), ivec2(k, m));
     return along[edge];
@@ -132,17 +148,20 @@ TerrainVertex terrainVertex(PatchInstance p, int id) {
     // bit.
     v.morph = morphFactor(p, length(positionAt(p, baseAt(p, v.grid), directionOffset(p, v.grid))));
     v.morphed = morphedGrid(v.grid, v.morph);
-    v.surface = surfaceAt(p, v.morphed, v.morph, v.flow);
+    vec2 flow;
+    v.surface = surfaceAt(p, v.morphed, v.morph, flow);
     v.offset = directionOffset(p, v.morphed);
     place(p, v, v.surface.x);
+    v.flow = flowTangent(p, flow, v.direction);
     return v;
 }
 
 // What a vertex's passes need beyond its place: its normal and the air between the eye and it.
 struct VertexShading {
     vec3 normal;
-    vec3 sunlight;   // the sunlight that reaches the vertex
-    Scattering air;
+    vec3 sunlight;       // the sunlight that reaches the vertex
+    vec3 inscatter;      // radiance the air scatters towards the eye (phase functions applied)
+    vec3 transmittance;  // what the air between the eye and the vertex lets through
 };
 
 // Normal from the four neighbours (one parent spacing apart when fully morphed); at the patch edges the neighbour
@@ -162,8 +181,16 @@ VertexShading shadeVertex(PatchInstance p, TerrainVertex v, bool withNormal) {
         if (dot(s.normal, v.direction) < 0.0) s.normal = -s.normal;
     }
     s.sunlight = vec3(1.0);
-    s.air = Scattering(vec3(0.0), vec3(0.0), vec3(1.0));
-    if (atmosphereOn()) s.air = airTo(v.position, v.surface.x, v.direction, s.sunlight);
+    s.inscatter = vec3(0.0);
+    s.transmittance = vec3(1.0);
+    if (atmosphereOn()) {
+        Scattering air = airTo(v.position, v.surface.x, v.direction, s.sunlight);
+        // The phase functions per vertex: the angle between the view ray and the sun changes slowly across a
+        // triangle (and the cache computes them once per grid point, not per drawn vertex).
+        float c = dot(normalize(v.position), normalize(frame.sun.xyz));
+        s.inscatter = inscattered(air.rayleigh, air.mie, c);
+        s.transmittance = air.transmittance;
+    }
     return s;
 }
 
@@ -174,8 +201,8 @@ VertexShading shadeVertex(PatchInstance p, TerrainVertex v, bool withNormal) {
 struct CachedVertex {
     vec4 normalMorph;  // the normal; the morph factor
     vec4 surface;      // height (of the grid point), water height, signed distance, half width
-    uvec4 shading;     // the flow, sunlight.rg, sunlight.b and rayleigh.r, rayleigh.gb
-    uvec4 air;         // mie.rg, mie.b and transmittance.r, transmittance.gb; w unused (std430 pads to 16 bytes)
+    uvec4 shading;     // flow.xy, flow.z and sunlight.r, sunlight.gb, inscatter.rg
+    uvec4 air;         // inscatter.b and transmittance.r, transmittance.gb; zw unused (std430 pads to 16 bytes)
 };
 
 #ifdef VERTEX_CACHE_WRITER
@@ -192,10 +219,9 @@ void storeVertex(uint index, TerrainVertex v, VertexShading s) {
     CachedVertex c;
     c.normalMorph = vec4(s.normal, v.morph);
     c.surface = v.surface;
-    c.shading = uvec4(packHalf2x16(v.flow), packHalf2x16(s.sunlight.rg),
-                      packHalf2x16(vec2(s.sunlight.b, s.air.rayleigh.r)), packHalf2x16(s.air.rayleigh.gb));
-    c.air = uvec4(packHalf2x16(s.air.mie.rg), packHalf2x16(vec2(s.air.mie.b, s.air.transmittance.r)),
-                  packHalf2x16(s.air.transmittance.gb), 0u);
+    c.shading = uvec4(packHalf2x16(v.flow.xy), packHalf2x16(vec2(v.flow.z, s.sunlight.r)), packHalf2x16(s.sunlight.gb),
+                      packHalf2x16(s.inscatter.rg));
+    c.air = uvec4(packHalf2x16(vec2(s.inscatter.b, s.transmittance.r)), packHalf2x16(s.transmittance.gb), 0u, 0u);
     cachedVertices[index] = c;
 }
 #else
@@ -208,15 +234,14 @@ void loadVertex(PatchInstance p, int id, out TerrainVertex v, out VertexShading 
     v.morphed = morphedGrid(v.grid, v.morph);
     v.offset = directionOffset(p, v.morphed);
     v.surface = c.surface;
-    v.flow = unpackHalf2x16(c.shading.x);
     place(p, v, c.surface.x);
+    vec2 flowZSunR = unpackHalf2x16(c.shading.y);
+    vec2 inscatterBTransmittanceR = unpackHalf2x16(c.air.x);
+    v.flow = vec3(unpackHalf2x16(c.shading.x), flowZSunR.x);
     s.normal = c.normalMorph.xyz;
-    vec2 sunBRayleighR = unpackHalf2x16(c.shading.z);
-    vec2 mieBTransmittanceR = unpackHalf2x16(c.air.y);
-    s.sunlight = vec3(unpackHalf2x16(c.shading.y), sunBRayleighR.x);
-    s.air.rayleigh = vec3(sunBRayleighR.y, unpackHalf2x16(c.shading.w));
-    s.air.mie = vec3(unpackHalf2x16(c.air.x), mieBTransmittanceR.x);
-    s.air.transmittance = vec3(mieBTransmittanceR.y, unpackHalf2x16(c.air.z));
+    s.sunlight = vec3(flowZSunR.y, unpackHalf2x16(c.shading.z));
+    s.inscatter = vec3(unpackHalf2x16(c.shading.w), inscatterBTransmittanceR.x);
+    s.transmittance = vec3(inscatterBTransmittanceR.y, unpackHalf2x16(c.air.y));
 }
 
 // Mesh vertex gl_VertexIndex of `p` and its shading: from the cache where the patch has an entry, else computed

@@ -47,7 +47,7 @@ void main() {
     if (gl_LocalInvocationIndex == 0) wetQuadrants = 0u;
     barrier();
     // Only the vertices of drawn quadrants' cells (culled quadrants are not drawn, their skirts hang from them).
-    uint around = id < n * n ? quadrantsAround(ivec2(id % n, id / n), n) : 0u;
+    uint around = id < n * n ? quadrantsAround(divMod(id, n).yx, n) : 0u;
     if ((around & uint(p.slots.z)) != 0u) {
         TerrainVertex v = terrainVertex(p, id);
         storeVertex(uint(entry * n * n + id), v, shadeVertex(p, v, true));

@@ -8,12 +8,12 @@
 layout(location = 0) out vec4 vLocalInstance;    // xyz: TerrainVertex.local; w: the instance
 layout(location = 1) out vec4 vRiver;            // final height, water height, signed distance, river half width
 layout(location = 2) out vec4 vDirectionEdge;    // xyz: unit direction from the planet centre; w: TerrainVertex.edge
-layout(location = 3) out vec4 vGridFlow;         // xy: (i, j) within the patch; zw: the flow in the patch frame
+layout(location = 3) out vec4 vGridFlowXY;       // xy: (i, j) within the patch; zw: the flow's x and y
 // The atmosphere between the camera and the terrain vertex (the water lies a little higher: the difference does
-// not show), as in terrain.vert: rayleigh, mie and transmittance, each with one channel of the sunlight in w.
-layout(location = 4) out vec4 vRayleighSunR;
-layout(location = 5) out vec4 vMieSunG;
-layout(location = 6) out vec4 vTransmittanceSunB;
+// not show), as in terrain.vert: in-scattered light and transmittance, with the sunlight and the flow's z.
+layout(location = 4) out vec4 vInscatterSunR;
+layout(location = 5) out vec4 vTransmittanceSunG;
+layout(location = 6) out vec2 vSunBFlowZ;
 
 void main() {
     PatchInstance p = instances[gl_InstanceIndex];
@@ -23,9 +23,9 @@ void main() {
     vLocalInstance = vec4(v.local, float(gl_InstanceIndex));
     vRiver = v.surface;
     vDirectionEdge = vec4(v.direction, float(v.edge));
-    vGridFlow = vec4(v.grid, v.flow);
-    vRayleighSunR = vec4(s.air.rayleigh, s.sunlight.r);
-    vMieSunG = vec4(s.air.mie, s.sunlight.g);
-    vTransmittanceSunB = vec4(s.air.transmittance, s.sunlight.b);
+    vGridFlowXY = vec4(v.grid, v.flow.xy);
+    vInscatterSunR = vec4(s.inscatter, s.sunlight.r);
+    vTransmittanceSunG = vec4(s.transmittance, s.sunlight.g);
+    vSunBFlowZ = vec2(s.sunlight.b, v.flow.z);
     gl_Position = frame.viewProjection * vec4(v.position, 1.0);
 }
