@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::gpu::{Access, ImageUse};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
@@ -174,12 +175,7 @@ impl HeightRefiner {
                     .take_while(|j| j.patch.level == level)
                     .count();
             if start > 0 {
-                rec.memory_barrier(
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_SAMPLED_READ,
-                );
+                rec.memory_barrier(&[Access::ComputeWrite], &[Access::ComputeSampled]);
             }
             let mut buffer = rec.ctx().create_buffer(&BufferDesc {
                 name: "height refinement jobs",
@@ -202,13 +198,7 @@ impl HeightRefiner {
             set?;
             start = end;
         }
-        rec.buffer_barrier(
-            &out.buffer,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
-        );
+        rec.buffer_barrier(&out.buffer, &[Access::ComputeWrite], &[Access::HostRead]);
         Ok(Some(out))
     }
 
@@ -220,14 +210,13 @@ impl HeightRefiner {
 
 /// Moves fresh base-height textures to GENERAL, ready for uploads and for the refinement shader's writes.
 pub fn prepare_height_textures(rec: &mut Recorder, images: &[&Image]) {
-    rec.image_transitions(
+    rec.image_barriers(
         images,
-        vk::ImageLayout::UNDEFINED,
-        vk::ImageLayout::GENERAL,
-        vk::PipelineStageFlags2::NONE,
-        vk::AccessFlags2::NONE,
-        vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::COMPUTE_SHADER,
-        vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        ImageUse {
+            before: &[Access::Nothing],
+            after: &[Access::TransferWrite, Access::ComputeWrite],
+            discard: true,
+        },
     );
 }
 
@@ -325,7 +314,7 @@ pub fn generate_on_gpu(
         slots.insert(*p, slot);
         match create_height_texture(ctx, n, &format!("base heights {p:?}")) {
             Ok(image) => {
-                bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+                bindless.write(ctx, slot, &image, true);
                 images.push(image);
             }
             Err(e) => {
@@ -356,12 +345,7 @@ pub fn generate_on_gpu(
         for (p, image) in all.iter().zip(&images) {
             if p.level as u32 <= planet.precomputed_level {
                 let heights = planet.lattice.patch_heights(*p, n);
-                rec.upload_image_layer(
-                    image,
-                    vk::ImageLayout::GENERAL,
-                    0,
-                    bytemuck::cast_slice(&heights.data),
-                )?;
+                rec.upload_image_layer(image, 0, bytemuck::cast_slice(&heights.data))?;
             } else {
                 let parent = p.parent().expect("refined patches have parents");
                 jobs.push(RefineJob {
@@ -371,38 +355,17 @@ pub fn generate_on_gpu(
                 });
             }
         }
-        rec.memory_barrier(
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_SAMPLED_READ,
-        );
+        rec.memory_barrier(&[Access::TransferWrite], &[Access::ComputeSampled]);
         let ranges = refiner.record(rec, bindless_ref, planet, &jobs)?;
-        rec.memory_barrier(
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_READ,
-        );
+        rec.memory_barrier(&[Access::ComputeWrite], &[Access::TransferRead]);
         for (k, p) in patches.iter().enumerate() {
             let index = all
                 .iter()
                 .position(|q| q == p)
                 .expect("every wanted patch is made");
-            rec.copy_image_to_buffer(
-                &images[index],
-                vk::ImageLayout::GENERAL,
-                &readback,
-                k as u64 * texel_bytes,
-            );
+            rec.copy_image_to_buffer(&images[index], &readback, k as u64 * texel_bytes);
         }
-        rec.buffer_barrier(
-            &readback,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
-        );
+        rec.buffer_barrier(&readback, &[Access::TransferWrite], &[Access::HostRead]);
         Ok(ranges)
     });
     let out = result.and_then(|ranges| {

@@ -5,9 +5,7 @@ mod common;
 
 use std::sync::OnceLock;
 
-use riverplanet::{
-    bench::path::Flight, config::Config, gpu::vk, render::target::Offscreen, world::World,
-};
+use riverplanet::{bench::path::Flight, config::Config, render::target::Offscreen, world::World};
 
 fn world() -> &'static World {
     static WORLD: OnceLock<World> = OnceLock::new();
@@ -30,15 +28,9 @@ fn a_flight_keeps_two_frames_in_flight_and_passes_synchronization_validation() {
     );
     let frames = 100;
     let flight = Flight::new(world, frames, 1.0, w as f64 / h as f64);
-    let mut layout = vk::ImageLayout::UNDEFINED;
     let mut timed = Vec::new();
     for frame in 0..frames {
-        let stats = common::render_frame(
-            &mut renderer,
-            &flight.camera(world, frame),
-            &target,
-            &mut layout,
-        );
+        let stats = common::render_frame(&mut renderer, &flight.camera(world, frame), &target);
         // The CPU never waited for the previous frame before submitting this one, and returned before the GPU
         // finished this one.
         assert!(
@@ -73,14 +65,8 @@ fn one_frame_in_flight_waits_for_every_frame_as_the_thesis() {
     let mut renderer = common::renderer(ctx, world);
     renderer.set_frames_in_flight(1).unwrap();
     let flight = Flight::new(world, 10, 1.0, 16.0 / 9.0);
-    let mut layout = vk::ImageLayout::UNDEFINED;
     for frame in 0..10 {
-        let stats = common::render_frame(
-            &mut renderer,
-            &flight.camera(world, frame),
-            &target,
-            &mut layout,
-        );
+        let stats = common::render_frame(&mut renderer, &flight.camera(world, frame), &target);
         assert_eq!(stats.synchronized_frame + 1, stats.frame);
     }
     assert!(renderer.set_frames_in_flight(4).is_err(), "at most three");

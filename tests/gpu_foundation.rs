@@ -5,7 +5,7 @@ mod common;
 use riverplanet::{
     gpu::{
         pipeline::{BufferSetLayout, ComputePipeline},
-        vk, BufferDesc, MemoryLocation, Profiler,
+        vk, Access, BufferDesc, MemoryLocation, Profiler,
     },
     shaders,
 };
@@ -47,13 +47,7 @@ fn compute_dispatch_reads_back_and_is_timed() {
             [COUNT.div_ceil(64), 1, 1],
         );
         profiler.end(rec, scope);
-        rec.buffer_barrier(
-            &out,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_READ,
-        );
+        rec.buffer_barrier(&out, &[Access::ComputeWrite], &[Access::TransferRead]);
         rec.copy_buffer(&out, &readback, size);
         Ok(())
     })

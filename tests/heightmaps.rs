@@ -604,15 +604,12 @@ fn the_exported_surface_is_the_surface_the_renderer_draws() {
     let camera = riverplanet::runtime::camera::Camera::look_at(eye, target, 60.0, 16.0 / 9.0, 0.05);
     let offscreen = riverplanet::render::target::Offscreen::new(ctx, 320, 180).unwrap();
     let mut renderer = common::renderer(ctx, &world);
-    let mut layout = riverplanet::gpu::vk::ImageLayout::UNDEFINED;
     let clear = offscreen.target([0.0, 0.0, 0.0, 1.0]);
     renderer
-        .render_until_streamed(&camera, &clear, &mut layout, 200)
+        .render_until_streamed(&camera, &clear, 200)
         .unwrap();
     renderer.capture_vertices = true;
-    renderer
-        .render_until_streamed(&camera, &clear, &mut layout, 1)
-        .unwrap();
+    renderer.render_until_streamed(&camera, &clear, 1).unwrap();
     let capture = renderer.last_capture.take().unwrap();
     renderer.destroy();
     offscreen.destroy(ctx);

@@ -9,7 +9,7 @@ use std::{collections::HashMap, sync::OnceLock};
 use glam::DVec3;
 use riverplanet::{
     config::Config,
-    gpu::{vk, Context},
+    gpu::{Access, Context},
     planet::cube::PatchId,
     render::{
         presets::{self, Preset},
@@ -96,7 +96,6 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
     let offscreen = Offscreen::new(ctx, size[0], size[1]).unwrap();
     let mut renderer = common::renderer(ctx, world);
     renderer.morphing = morphing;
-    let mut layout = vk::ImageLayout::UNDEFINED;
     let mut previous: Option<VertexCapture> = None;
     let (mut largest, mut compared) = (0.0f64, 0);
     let mut altitude: f64 = 140.0;
@@ -106,19 +105,14 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
         // Stream until every visible patch has its own data, then capture.
         renderer.capture_vertices = false;
         renderer
-            .render_until_streamed(
-                &camera,
-                &offscreen.target([0.0, 0.0, 0.0, 1.0]),
-                &mut layout,
-                50,
-            )
+            .render_until_streamed(&camera, &offscreen.target([0.0, 0.0, 0.0, 1.0]), 50)
             .unwrap();
         renderer.capture_vertices = true;
         renderer
             .render(
                 &camera,
                 &offscreen.target([0.0, 0.0, 0.0, 1.0]),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                Access::ColorAttachment,
                 &[],
                 &[],
             )

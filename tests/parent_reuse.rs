@@ -10,7 +10,7 @@ use glam::DVec3;
 
 use riverplanet::{
     config::Config,
-    gpu::{bindless::Bindless, vk},
+    gpu::bindless::Bindless,
     kernel::{
         cpu,
         gpu::{run_batch_into, BatchOutputs, KernelTuning, KernelVariant, RiverKernel},
@@ -197,21 +197,16 @@ fn ground_vertices(parent_reuse: bool) -> Option<(VertexCapture, usize)> {
     let target = offscreen.target([0.0, 0.0, 0.0, 1.0]);
     let mut renderer = common::renderer(ctx, &world);
     renderer.parent_reuse = parent_reuse;
-    let mut layout = vk::ImageLayout::UNDEFINED;
     let mut from_parent = 0;
     for _ in 0..60 {
-        let (stats, _) = renderer
-            .render_until_streamed(&camera, &target, &mut layout, 1)
-            .unwrap();
+        let (stats, _) = renderer.render_until_streamed(&camera, &target, 1).unwrap();
         from_parent += stats.river_patches_from_parent;
         if stats.streamed() {
             break;
         }
     }
     renderer.capture_vertices = true;
-    renderer
-        .render_until_streamed(&camera, &target, &mut layout, 1)
-        .unwrap();
+    renderer.render_until_streamed(&camera, &target, 1).unwrap();
     let capture = renderer.last_capture.take().unwrap();
     renderer.destroy();
     offscreen.destroy(ctx);

@@ -9,7 +9,6 @@ use std::{collections::HashMap, path::Path};
 use glam::DVec3;
 use riverplanet::{
     config::Config,
-    gpu::vk,
     planet::cube::PatchId,
     render::{
         presets::{self, Preset},
@@ -48,12 +47,11 @@ fn two_metres_above_an_earth_sized_river_vertices_are_exact_to_a_millimetre_and_
     let offscreen = Offscreen::new(ctx, 64, 36).unwrap();
     let mut renderer = common::renderer(ctx, &world);
     let target = offscreen.target([0.0, 0.0, 0.0, 1.0]);
-    let mut layout = vk::ImageLayout::UNDEFINED;
     // `frames` frames at most, until every visible patch has its data.
-    let mut frame = |renderer: &mut Renderer, camera: &Camera, capture: bool, frames: u32| {
+    let frame = |renderer: &mut Renderer, camera: &Camera, capture: bool, frames: u32| {
         renderer.capture_vertices = capture;
         let (stats, _) = renderer
-            .render_until_streamed(camera, &target, &mut layout, frames)
+            .render_until_streamed(camera, &target, frames)
             .unwrap();
         stats
     };

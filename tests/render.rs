@@ -8,7 +8,7 @@ use glam::DVec3;
 use riverplanet::{
     bench::holes::{hole_pixels, HOLE_COLOUR},
     config::Config,
-    gpu::{vk, Context},
+    gpu::Context,
     render::{
         presets::{self, Preset},
         target::Offscreen,
@@ -195,9 +195,8 @@ fn render_cleared(
     let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
     let mut renderer = common::renderer(ctx, world);
     setup(&mut renderer);
-    let mut layout = vk::ImageLayout::UNDEFINED;
     renderer
-        .render_until_streamed(camera, &target.target(clear), &mut layout, 100)
+        .render_until_streamed(camera, &target.target(clear), 100)
         .unwrap();
     let image = target.read(ctx).unwrap();
     renderer.destroy();

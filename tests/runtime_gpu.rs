@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 use riverplanet::{
     bench::path::Flight,
     config::Config,
-    gpu::{bindless::Bindless, vk},
+    gpu::bindless::Bindless,
     kernel::{
         gpu::{run_batch, KernelTuning, KernelVariant, RiverKernel},
         KernelParams, PatchJob,
@@ -131,15 +131,9 @@ fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
     .unwrap();
     let frames = 200;
     let flight = Flight::new(world, frames, 25.0, 1.5);
-    let mut layout = vk::ImageLayout::UNDEFINED;
     let mut evicted = 0;
     for frame in 0..frames {
-        let stats = common::render_frame(
-            &mut renderer,
-            &flight.camera(world, frame),
-            &target,
-            &mut layout,
-        );
+        let stats = common::render_frame(&mut renderer, &flight.camera(world, frame), &target);
         evicted += stats.evicted_patches;
         assert!(
             stats.resident_patches <= 96,

@@ -14,7 +14,7 @@ use super::{
 };
 use crate::{
     config::Config,
-    gpu::{vk, Context, GpuError},
+    gpu::{Access, Context, GpuError},
     kernel::{gpu::KernelTuning, KernelParams, PatchJob},
     render::{
         target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
@@ -212,7 +212,6 @@ fn fly(
         Flight::new(world, options.frames, speed, aspect)
     };
     let mut frames = Vec::with_capacity(options.frames as usize);
-    let mut layout = vk::ImageLayout::UNDEFINED;
     // Below the lowest height anything is drawn at: rays hitting this sphere must hit terrain or water.
     let inner = world.planet.radius + world.planet.height_bounds().0 as f64
         - config.river.basin_depth as f64
@@ -230,11 +229,10 @@ fn fly(
                 } else {
                     [0.02, 0.03, 0.06, 1.0]
                 }),
-                (layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                Access::ColorAttachment,
                 &[],
                 &[],
             )?;
-            layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
             let compare = runner.is_some() && !renderer.last_batch.is_empty();
             let check_holes = options.descent && frame % HOLE_CHECK_EVERY == 0;
             if compare || check_holes {

@@ -1,6 +1,6 @@
 //! `riverplanet render` (headless) and `riverplanet view` (the interactive viewer).
 
-use riverplanet::gpu::{self, Context, ContextOptions};
+use riverplanet::gpu::{Context, ContextOptions};
 
 use super::{RenderArgs, ViewArgs};
 use crate::{check_output, load_config, planet_seed, usage};
@@ -94,13 +94,8 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     }
     let c = args.clear_color;
     let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
-    let mut layout = gpu::vk::ImageLayout::UNDEFINED;
-    let (stats, frames) = renderer.render_until_streamed(
-        &camera,
-        &target.target(clear),
-        &mut layout,
-        args.max_frames,
-    )?;
+    let (stats, frames) =
+        renderer.render_until_streamed(&camera, &target.target(clear), args.max_frames)?;
     let image = target.read(&ctx)?;
     riverplanet::export::files::save_image(&image, &args.out)?;
     println!(

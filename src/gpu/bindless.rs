@@ -5,7 +5,7 @@
 
 use ash::vk;
 
-use super::{Context, GpuError, Image, VkResultExt};
+use super::{Access, Context, GpuError, Image, VkResultExt};
 
 /// The debug name of the set, which validation messages quote.
 pub(crate) const SET_NAME: &str = "bindless set";
@@ -160,22 +160,16 @@ impl Bindless {
         self.released.len()
     }
 
-    /// Points `slot` at `image`: as a storage image in GENERAL layout (if `storage`), and as a sampled image in
-    /// `sampled_layout`.
-    pub fn write(
-        &self,
-        ctx: &Context,
-        slot: Slot,
-        image: &Image,
-        storage: bool,
-        sampled_layout: vk::ImageLayout,
-    ) {
+    /// Points `slot` at `image`: as a storage image (if `storage`) and as a sampled image, in the layout shaders
+    /// find it in (GENERAL: gpu/access.rs).
+    pub fn write(&self, ctx: &Context, slot: Slot, image: &Image, storage: bool) {
+        let layout = Access::GraphicsSampled.layout(image.shader_visible());
         let storage_info = [vk::DescriptorImageInfo::default()
             .image_view(image.view)
-            .image_layout(vk::ImageLayout::GENERAL)];
+            .image_layout(layout)];
         let sampled_info = [vk::DescriptorImageInfo::default()
             .image_view(image.view)
-            .image_layout(sampled_layout)
+            .image_layout(layout)
             .sampler(self.sampler)];
         let mut writes = vec![vk::WriteDescriptorSet::default()
             .dst_set(self.set)

@@ -103,7 +103,7 @@ impl<T> FrameRing<T> {
     pub fn submit(
         &mut self,
         rec: Recorder,
-        waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+        waits: &[(vk::Semaphore, super::Access)],
         signals: &[vk::Semaphore],
         payload: T,
     ) -> Result<SubmissionId, GpuError> {

@@ -87,10 +87,17 @@ pub struct Image {
     pub layers: u32,
     pub format: vk::Format,
     pub name: String,
+    usage: vk::ImageUsageFlags,
     allocation: Option<Allocation>,
 }
 
 impl Image {
+    /// Whether shaders read or write it (storage or sampled usage): such images stay in GENERAL (gpu/access.rs).
+    pub fn shader_visible(&self) -> bool {
+        self.usage
+            .intersects(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED)
+    }
+
     /// The subresource range of the whole image.
     pub fn range(&self) -> vk::ImageSubresourceRange {
         let aspect = if self.format == vk::Format::D32_SFLOAT {
@@ -281,6 +288,7 @@ impl Context {
             layers: desc.layers,
             format: desc.format,
             name: desc.name.to_string(),
+            usage: desc.usage,
             allocation: Some(allocation),
         })
     }

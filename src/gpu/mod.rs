@@ -1,12 +1,14 @@
 //! The Vulkan backend: the only module that imports `ash`. It knows nothing of planets.
 //!
-//! One file per concern, as in wgpu-hal: [`context`] (instance, device choice, device, queue, allocator),
+//! One file per concern, as in wgpu-hal: [`access`] (the synchronisation vocabulary: every barrier names uses, not
+//! stage and access flags), [`context`] (instance, device choice, device, queue, allocator),
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
 //! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`frames`] (the ring of
 //! frame contexts that keeps frames in flight), [`bindless`] (the global descriptor-indexed set), [`pipeline`]
 //! (shader modules and pipelines), [`profiler`] (timestamp scopes), [`swapchain`] (window presentation), [`overlay`]
 //! (egui's triangles, for the viewer).
 
+pub mod access;
 pub mod bindless;
 pub mod context;
 pub mod features;
@@ -18,6 +20,7 @@ pub mod profiler;
 pub mod submit;
 pub mod swapchain;
 
+pub use access::{Access, ImageUse};
 pub use ash::vk;
 pub use context::{AdapterInfo, Context, ContextOptions};
 pub use features::FeatureReport;

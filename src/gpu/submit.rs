@@ -6,7 +6,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use ash::vk;
 
-use super::{Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, VkResultExt};
+use super::{
+    access::{self, Access, ImageUse},
+    Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, VkResultExt,
+};
 
 /// The timeline semaphore that every submission signals.
 pub(crate) struct Timeline {
@@ -252,25 +255,19 @@ impl<'a> Recorder<'a> {
                 .device
                 .cmd_copy_buffer(self.cmd, src, dst.raw, &[region])
         };
-        self.buffer_barrier(
-            dst,
-            vk::PipelineStageFlags2::TRANSFER,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_STORAGE_READ,
-        );
+        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::AnyShaderRead]);
         Ok(())
     }
 
     /// Copies tightly packed texels into array layer `layer` of `dst` through a staging buffer. The image must be in
-    /// `layout`: TRANSFER_DST_OPTIMAL or GENERAL.
+    /// its layout for [`Access::TransferWrite`] (after a barrier to that use).
     pub fn upload_image_layer(
         &mut self,
         dst: &Image,
-        layout: vk::ImageLayout,
         layer: u32,
         data: &[u8],
     ) -> Result<(), GpuError> {
+        let layout = Access::TransferWrite.layout(dst.shader_visible());
         let src = self.stage(&dst.name, data)?;
         let region = vk::BufferImageCopy::default()
             .image_subresource(
@@ -284,7 +281,7 @@ impl<'a> Recorder<'a> {
                 height: dst.extent.height,
                 depth: 1,
             });
-        // SAFETY: the image is in `layout` (caller's contract) and alive until completion.
+        // SAFETY: the image is in `layout` (caller's contract: the barrier before) and alive until completion.
         unsafe {
             self.ctx
                 .device
@@ -293,15 +290,10 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
-    /// Copies the whole of `src` (in `layout`: GENERAL or TRANSFER_SRC_OPTIMAL) into `dst` at `offset`, layer after
+    /// Copies the whole of `src` (in its layout for [`Access::TransferRead`]) into `dst` at `offset`, layer after
     /// layer, tightly packed.
-    pub fn copy_image_to_buffer(
-        &mut self,
-        src: &Image,
-        layout: vk::ImageLayout,
-        dst: &Buffer,
-        offset: u64,
-    ) {
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        let layout = Access::TransferRead.layout(src.shader_visible());
         let region = vk::BufferImageCopy::default()
             .buffer_offset(offset)
             .image_subresource(
@@ -314,7 +306,7 @@ impl<'a> Recorder<'a> {
                 height: src.extent.height,
                 depth: 1,
             });
-        // SAFETY: layouts are the caller's contract; both objects outlive the submission.
+        // SAFETY: the layout is the caller's contract (the barrier before); both objects outlive the submission.
         unsafe {
             self.ctx
                 .device
@@ -331,13 +323,7 @@ impl<'a> Recorder<'a> {
                 .device
                 .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region])
         };
-        self.buffer_barrier(
-            dst,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
-        );
+        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::HostRead]);
     }
 
     /// Fills all of `buffer` with the `u32` `value` (for buffers the GPU accumulates into, e.g. with atomics).
@@ -350,69 +336,29 @@ impl<'a> Recorder<'a> {
         };
     }
 
-    pub fn buffer_barrier(
-        &mut self,
-        buffer: &Buffer,
-        src_stage: vk::PipelineStageFlags2,
-        src_access: vk::AccessFlags2,
-        dst_stage: vk::PipelineStageFlags2,
-        dst_access: vk::AccessFlags2,
-    ) {
-        let barrier = [vk::BufferMemoryBarrier2::default()
-            .buffer(buffer.raw)
-            .size(vk::WHOLE_SIZE)
-            .src_stage_mask(src_stage)
-            .src_access_mask(src_access)
-            .dst_stage_mask(dst_stage)
-            .dst_access_mask(dst_access)];
+    /// A barrier between the uses `before` and `after` of `buffer` (gpu/access.rs).
+    pub fn buffer_barrier(&mut self, buffer: &Buffer, before: &[Access], after: &[Access]) {
+        let barrier = [access::buffer_barrier(buffer.raw, before, after)];
         let dep = vk::DependencyInfo::default().buffer_memory_barriers(&barrier);
         // SAFETY: recording.
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
-    /// A global memory barrier (cheaper to write than per-resource barriers when many patches are involved).
-    pub fn memory_barrier(
-        &mut self,
-        src_stage: vk::PipelineStageFlags2,
-        src_access: vk::AccessFlags2,
-        dst_stage: vk::PipelineStageFlags2,
-        dst_access: vk::AccessFlags2,
-    ) {
-        let barrier = [vk::MemoryBarrier2::default()
-            .src_stage_mask(src_stage)
-            .src_access_mask(src_access)
-            .dst_stage_mask(dst_stage)
-            .dst_access_mask(dst_access)];
+    /// A barrier between the uses `before` and `after` of every resource (cheaper to write than one per resource
+    /// when many patches are involved).
+    pub fn memory_barrier(&mut self, before: &[Access], after: &[Access]) {
+        let barrier = [access::memory_barrier(before, after)];
         let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
         // SAFETY: recording.
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
-    /// Transitions every subresource of each image from `old` to `new` layout, with full stage/access masks on
-    /// both sides of the given stages.
-    #[allow(clippy::too_many_arguments)]
-    pub fn image_transitions(
-        &mut self,
-        images: &[&Image],
-        old: vk::ImageLayout,
-        new: vk::ImageLayout,
-        src_stage: vk::PipelineStageFlags2,
-        src_access: vk::AccessFlags2,
-        dst_stage: vk::PipelineStageFlags2,
-        dst_access: vk::AccessFlags2,
-    ) {
+    /// Barriers of every subresource of each of `images` for `usage`.
+    pub fn image_barriers(&mut self, images: &[&Image], usage: ImageUse) {
         let barriers: Vec<_> = images
             .iter()
             .map(|image| {
-                vk::ImageMemoryBarrier2::default()
-                    .image(image.raw)
-                    .subresource_range(image.range())
-                    .old_layout(old)
-                    .new_layout(new)
-                    .src_stage_mask(src_stage)
-                    .src_access_mask(src_access)
-                    .dst_stage_mask(dst_stage)
-                    .dst_access_mask(dst_access)
+                access::image_barrier(image.raw, image.range(), image.shader_visible(), &usage)
             })
             .collect();
         if barriers.is_empty() {
@@ -423,31 +369,18 @@ impl<'a> Recorder<'a> {
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
-    /// Transitions one raw image (e.g. a swapchain image) between layouts.
-    #[allow(clippy::too_many_arguments)]
-    pub fn raw_image_transition(
-        &mut self,
-        image: vk::Image,
-        aspect: vk::ImageAspectFlags,
-        old: vk::ImageLayout,
-        new: vk::ImageLayout,
-        src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-        dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    ) {
-        let barrier = [vk::ImageMemoryBarrier2::default()
-            .image(image)
-            .subresource_range(
-                vk::ImageSubresourceRange::default()
-                    .aspect_mask(aspect)
-                    .level_count(1)
-                    .layer_count(1),
-            )
-            .old_layout(old)
-            .new_layout(new)
-            .src_stage_mask(src.0)
-            .src_access_mask(src.1)
-            .dst_stage_mask(dst.0)
-            .dst_access_mask(dst.1)];
+    /// A barrier of an attachment that is not one of our [`Image`]s (a swapchain image, or a render target's
+    /// image), a depth attachment if `depth`, for `usage`.
+    pub fn attachment_barrier(&mut self, image: vk::Image, depth: bool, usage: ImageUse) {
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(if depth {
+                vk::ImageAspectFlags::DEPTH
+            } else {
+                vk::ImageAspectFlags::COLOR
+            })
+            .level_count(1)
+            .layer_count(1);
+        let barrier = [access::image_barrier(image, range, false, &usage)];
         let dep = vk::DependencyInfo::default().image_memory_barriers(&barrier);
         // SAFETY: recording.
         unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
@@ -456,7 +389,7 @@ impl<'a> Recorder<'a> {
     /// Ends recording and submits; `waits`/`signals` are binary semaphores (swapchain acquire/present).
     pub fn submit_with(
         self,
-        waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+        waits: &[(vk::Semaphore, Access)],
         signals: &[vk::Semaphore],
     ) -> Result<SubmissionId, GpuError> {
         let ctx = self.ctx;
@@ -466,10 +399,10 @@ impl<'a> Recorder<'a> {
         let value = ctx.timeline.last_submitted() + 1;
         let wait_infos: Vec<_> = waits
             .iter()
-            .map(|&(s, stage)| {
+            .map(|&(s, access)| {
                 vk::SemaphoreSubmitInfo::default()
                     .semaphore(s)
-                    .stage_mask(stage)
+                    .stage_mask(access.stages())
             })
             .collect();
         let mut signal_infos: Vec<_> = signals

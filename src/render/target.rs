@@ -4,6 +4,7 @@ use crate::gpu::{
     pipeline::RenderTarget, vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation,
     Recorder,
 };
+use crate::gpu::{Access, ImageUse};
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -62,36 +63,23 @@ impl Offscreen {
             location: MemoryLocation::GpuToCpu,
         })?;
         let result = ctx.run_and_wait("read offscreen colour", |rec: &mut Recorder| {
-            rec.image_transitions(
+            rec.image_barriers(
                 &[&self.color],
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_READ,
+                ImageUse {
+                    before: &[Access::ColorAttachment],
+                    after: &[Access::TransferRead],
+                    discard: false,
+                },
             );
-            rec.copy_image_to_buffer(
-                &self.color,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                &buffer,
-                0,
-            );
-            rec.buffer_barrier(
-                &buffer,
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::PipelineStageFlags2::HOST,
-                vk::AccessFlags2::HOST_READ,
-            );
-            rec.image_transitions(
+            rec.copy_image_to_buffer(&self.color, &buffer, 0);
+            rec.buffer_barrier(&buffer, &[Access::TransferWrite], &[Access::HostRead]);
+            rec.image_barriers(
                 &[&self.color],
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_READ,
-                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                ImageUse {
+                    before: &[Access::TransferRead],
+                    after: &[Access::ColorAttachment],
+                    discard: false,
+                },
             );
             Ok(())
         });

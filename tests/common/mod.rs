@@ -7,7 +7,7 @@
 use std::sync::OnceLock;
 
 use riverplanet::{
-    gpu::{vk, Context, ContextOptions},
+    gpu::{Access, Context, ContextOptions},
     render::{
         target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
         FrameStats, Renderer,
@@ -82,23 +82,15 @@ pub fn renderer<'a>(ctx: &'a Context, world: &'a World) -> Renderer<'a> {
     .unwrap()
 }
 
-/// Renders one frame of `camera` into `target` (cleared to black), its colour image in `*layout` before and in
-/// COLOR_ATTACHMENT_OPTIMAL after, without waiting for it.
-pub fn render_frame(
-    renderer: &mut Renderer,
-    camera: &Camera,
-    target: &Offscreen,
-    layout: &mut vk::ImageLayout,
-) -> FrameStats {
-    let stats = renderer
+/// Renders one frame of `camera` into `target` (cleared to black), without waiting for it.
+pub fn render_frame(renderer: &mut Renderer, camera: &Camera, target: &Offscreen) -> FrameStats {
+    renderer
         .render(
             camera,
             &target.target([0.0, 0.0, 0.0, 1.0]),
-            (*layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+            Access::ColorAttachment,
             &[],
             &[],
         )
-        .unwrap();
-    *layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
-    stats
+        .unwrap()
 }

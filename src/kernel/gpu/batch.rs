@@ -2,6 +2,7 @@
 //! and the kernel benchmarks.
 
 use super::{create_river_texture, KernelBatch, KernelVariant, RiverKernel, RIVER_TEXTURE_LAYERS};
+use crate::gpu::Access;
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
@@ -83,7 +84,7 @@ impl BatchOutputs {
                     return Err(e);
                 }
             };
-            bindless.write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            bindless.write(ctx, slot, &image, true);
             outputs.images.push(image);
         }
         Ok(outputs)
@@ -166,27 +167,11 @@ pub fn run_batch_into(
         let scope = profiler.begin(rec, "kernel")?;
         let bytes = kernel.record(rec, bindless, variant, &batch, params)?;
         profiler.end(rec, scope);
-        rec.memory_barrier(
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_READ,
-        );
+        rec.memory_barrier(&[Access::ComputeWrite], &[Access::TransferRead]);
         for (k, image) in images.iter().enumerate() {
-            rec.copy_image_to_buffer(
-                image,
-                vk::ImageLayout::GENERAL,
-                readback,
-                k as u64 * texel_bytes,
-            );
+            rec.copy_image_to_buffer(image, readback, k as u64 * texel_bytes);
         }
-        rec.buffer_barrier(
-            readback,
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
-        );
+        rec.buffer_barrier(readback, &[Access::TransferWrite], &[Access::HostRead]);
         Ok(bytes)
     });
     let outcome = result.and_then(|temporary_bytes| {

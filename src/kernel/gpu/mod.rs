@@ -7,6 +7,7 @@ mod batch;
 mod jobs;
 mod tuning;
 
+use crate::gpu::{Access, ImageUse};
 use bytemuck::{Pod, Zeroable};
 
 pub use self::{
@@ -143,26 +144,20 @@ impl RiverKernel {
         batch: &KernelBatch,
         params: &KernelParams,
     ) -> Result<u64, GpuError> {
-        rec.image_transitions(
+        rec.image_barriers(
             batch.textures,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::GENERAL,
-            vk::PipelineStageFlags2::NONE,
-            vk::AccessFlags2::NONE,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            ImageUse {
+                before: &[Access::Nothing],
+                after: &[Access::ComputeWrite],
+                discard: true,
+            },
         );
         if batch.jobs.is_empty() {
             return Ok(0);
         }
         if batch.parents.iter().any(Option::is_some) {
             // The parents' river textures were written by an earlier dispatch.
-            rec.memory_barrier(
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ,
-            );
+            rec.memory_barrier(&[Access::ComputeWrite], &[Access::ComputeRead]);
         }
         let ctx = rec.ctx();
         let host_buffer = |name: &str, size: usize| {
@@ -252,10 +247,8 @@ impl RiverKernel {
             // ALL_TRANSFER: the spec puts fills in the CLEAR stage, older validation layers in COPY.
             rec.buffer_barrier(
                 &masks,
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                &[Access::TransferWrite],
+                &[Access::ComputeRead, Access::ComputeWrite],
             );
             let rows = table.rows.len() as u32;
             rec.dispatch(
@@ -264,13 +257,7 @@ impl RiverKernel {
                 bytemuck::bytes_of(&push(0)),
                 [1, rows, 1],
             );
-            rec.buffer_barrier(
-                &masks,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ,
-            );
+            rec.buffer_barrier(&masks, &[Access::ComputeWrite], &[Access::ComputeRead]);
             for (first, count, [x, y]) in groups.into_iter().filter(|g| g.1 > 0) {
                 let size = [x.div_ceil(bx), y.div_ceil(by), count as u32];
                 let push = push(first);

@@ -11,6 +11,7 @@ use super::{
     vertex_cache::VertexCache,
     FrameStats, Renderer,
 };
+use crate::gpu::{Access, ImageUse};
 use crate::{
     gpu::{
         pipeline::RenderTarget, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
@@ -141,14 +142,14 @@ impl Renderer<'_> {
         StandIns { drawn, below }
     }
 
-    /// Records the terrain and water passes of `visible` into `target`, whose colour image is in
-    /// `color_layouts.0` and is left in `color_layouts.1`.
+    /// Records the terrain and water passes of `visible` into `target`, whose colour image is cleared and left
+    /// ready for the use `after` (drawing on, reading back or presenting).
     pub(super) fn record_draw(
         &mut self,
         rec: &mut Recorder,
         camera: &Camera,
         visible: &[Selected],
-        (target, color_layouts): (&RenderTarget, (vk::ImageLayout, vk::ImageLayout)),
+        (target, after): (&RenderTarget, Access),
         stats: &mut FrameStats,
         overlay: Option<super::Overlay<'_>>,
     ) -> Result<Drawn, GpuError> {
@@ -268,10 +269,8 @@ impl Renderer<'_> {
             // ALL_TRANSFER: the spec puts fills in the CLEAR stage, older validation layers in COPY.
             rec.buffer_barrier(
                 &buffer,
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::PipelineStageFlags2::VERTEX_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                &[Access::TransferWrite],
+                &[Access::VertexShaderWrite],
             );
             Some(buffer)
         } else {
@@ -300,36 +299,25 @@ impl Renderer<'_> {
             .record(rec, (&sets, push), (&vertex_cache, &water_draws), cached, n);
         self.frames.profiler().end(rec, scope);
         rec.free_after_completion(vertex_cache);
-        rec.raw_image_transition(
+        // The target is cleared, so its contents are discarded; the wait for the earlier writes to it (the frame
+        // before, which may still be in flight, or the swapchain's acquire, waited for at colour output) stays.
+        rec.attachment_barrier(
             target.color_image,
-            vk::ImageAspectFlags::COLOR,
-            color_layouts.0,
-            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            // After the previous frame's writes to the same target, which may still be in flight.
-            (
-                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-            ),
+            false,
+            ImageUse {
+                before: &[Access::ColorAttachment],
+                after: &[Access::ColorAttachment],
+                discard: true,
+            },
         );
-        rec.raw_image_transition(
+        rec.attachment_barrier(
             target.depth_image,
-            vk::ImageAspectFlags::DEPTH,
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            (
-                vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
-                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
-            ),
+            true,
+            ImageUse {
+                before: &[Access::DepthAttachment],
+                after: &[Access::DepthAttachment],
+                discard: true,
+            },
         );
         rec.begin_rendering(target, true);
         let scope = self.frames.profiler().begin(rec, "terrain")?;
@@ -374,20 +362,15 @@ impl Renderer<'_> {
             draw(rec, target.extent);
         }
         rec.end_rendering();
-        if color_layouts.1 != vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL {
-            rec.raw_image_transition(
+        if after != Access::ColorAttachment {
+            rec.attachment_barrier(
                 target.color_image,
-                vk::ImageAspectFlags::COLOR,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                color_layouts.1,
-                (
-                    vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                    vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
-                    vk::AccessFlags2::NONE,
-                ),
+                false,
+                ImageUse {
+                    before: &[Access::ColorAttachment],
+                    after: &[after],
+                    discard: false,
+                },
             );
         }
         Ok(Drawn {

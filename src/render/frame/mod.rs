@@ -28,7 +28,7 @@ use crate::{
         bindless::{Bindless, Slot},
         frames::{FrameRing, FRAMES_IN_FLIGHT},
         pipeline::{Blend, BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
-        vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
+        vk, Access, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
     },
     kernel::{
         gpu::{KernelTuning, KernelVariant, RiverKernel},
@@ -387,20 +387,12 @@ impl<'w> Renderer<'w> {
         &mut self,
         camera: &Camera,
         target: &RenderTarget,
-        layout: &mut vk::ImageLayout,
         max_frames: u32,
     ) -> Result<(FrameStats, u32), GpuError> {
         let mut frames = 0;
         loop {
             let start = Instant::now();
-            let stats = self.render(
-                camera,
-                target,
-                (*layout, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                &[],
-                &[],
-            )?;
-            *layout = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
+            let stats = self.render(camera, target, Access::ColorAttachment, &[], &[])?;
             frames += 1;
             if stats.streamed() || frames >= max_frames {
                 let mut stats = stats;
@@ -414,19 +406,19 @@ impl<'w> Renderer<'w> {
         }
     }
 
-    /// Renders one frame into `target`, whose colour image is in `color_layouts.0` and is left in
-    /// `color_layouts.1`. `waits` and `signals` are binary semaphores (swapchain). Does not wait for this frame:
+    /// Renders one frame into `target`, whose colour image is cleared and left ready for the use `after` (more
+    /// drawing or a read-back: `Access::ColorAttachment`; `Access::Present`). `waits` and `signals` are binary semaphores (swapchain). Does not wait for this frame:
     /// it waits only for the frame that last used the same frame context (`FRAMES_IN_FLIGHT` back), and collects
     /// what finished frames left (height ranges, vertex capture, GPU times). `finish` waits for all of them.
     pub fn render(
         &mut self,
         camera: &Camera,
         target: &RenderTarget,
-        color_layouts: (vk::ImageLayout, vk::ImageLayout),
-        waits: &[(vk::Semaphore, vk::PipelineStageFlags2)],
+        after: Access,
+        waits: &[(vk::Semaphore, Access)],
         signals: &[vk::Semaphore],
     ) -> Result<FrameStats, GpuError> {
-        self.render_with_overlay(camera, target, color_layouts, (waits, signals), None)
+        self.render_with_overlay(camera, target, after, (waits, signals), None)
     }
 
     /// As [`Renderer::render`], with `overlay` recording its draws into the frame's rendering after the sky (the
@@ -435,11 +427,8 @@ impl<'w> Renderer<'w> {
         &mut self,
         camera: &Camera,
         target: &RenderTarget,
-        color_layouts: (vk::ImageLayout, vk::ImageLayout),
-        (waits, signals): (
-            &[(vk::Semaphore, vk::PipelineStageFlags2)],
-            &[vk::Semaphore],
-        ),
+        after: Access,
+        (waits, signals): (&[(vk::Semaphore, Access)], &[vk::Semaphore]),
         overlay: Option<Overlay<'_>>,
     ) -> Result<FrameStats, GpuError> {
         let start = Instant::now();
@@ -475,7 +464,7 @@ impl<'w> Renderer<'w> {
             &mut rec,
             camera,
             &visible,
-            (target, color_layouts),
+            (target, after),
             &mut stats,
             overlay,
         )?;

@@ -2,6 +2,7 @@
 //! bindless texture that every pass reads, and the sky pass that draws the air where no surface is.
 
 use super::{FramePush, Renderer};
+use crate::gpu::{Access, ImageUse};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
@@ -52,31 +53,22 @@ impl Sky {
             array: true,
         })?;
         ctx.run_and_wait("upload atmosphere transmittance", |rec| {
-            rec.image_transitions(
+            rec.image_barriers(
                 &[&image],
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::GENERAL,
-                vk::PipelineStageFlags2::NONE,
-                vk::AccessFlags2::NONE,
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_WRITE,
+                ImageUse {
+                    before: &[Access::Nothing],
+                    after: &[Access::TransferWrite],
+                    discard: true,
+                },
             );
-            rec.upload_image_layer(
-                &image,
-                vk::ImageLayout::GENERAL,
-                0,
-                bytemuck::cast_slice(&table.texels),
-            )?;
-            rec.image_transitions(
+            rec.upload_image_layer(&image, 0, bytemuck::cast_slice(&table.texels))?;
+            rec.image_barriers(
                 &[&image],
-                vk::ImageLayout::GENERAL,
-                vk::ImageLayout::GENERAL,
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_WRITE,
-                vk::PipelineStageFlags2::VERTEX_SHADER
-                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
-                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_SAMPLED_READ,
+                ImageUse {
+                    before: &[Access::TransferWrite],
+                    after: &[Access::GraphicsSampled],
+                    discard: false,
+                },
             );
             Ok(())
         })?;
@@ -85,7 +77,7 @@ impl Sky {
         let slot = bindless.allocate(ctx).ok_or_else(|| {
             GpuError::Invalid("no bindless slot left for the atmosphere".to_string())
         })?;
-        bindless.write(ctx, slot, &image, false, vk::ImageLayout::GENERAL);
+        bindless.write(ctx, slot, &image, false);
         // The dome lies at depth 0: only pixels no surface covered pass the depth test.
         let pipeline = GraphicsPipeline::new(
             ctx,

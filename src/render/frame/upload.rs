@@ -7,8 +7,9 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use super::Renderer;
+use crate::gpu::Access;
 use crate::{
-    gpu::{bindless::Slot, vk, GpuError, Image, Recorder},
+    gpu::{bindless::Slot, GpuError, Image, Recorder},
     kernel::{
         gpu::{create_river_texture, KernelBatch},
         ParentQuadrant, PatchJob, RiverSample,
@@ -98,8 +99,7 @@ impl Renderer<'_> {
         for p in prepared {
             let image = create_height_texture(ctx, n, &format!("base heights {:?}", p.patch))?;
             let slot = self.slot()?;
-            self.bindless
-                .write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            self.bindless.write(ctx, slot, &image, true);
             bases.push((image, slot));
         }
         let base_refs: Vec<&Image> = bases.iter().map(|(i, _)| i).collect();
@@ -111,12 +111,7 @@ impl Renderer<'_> {
         for (p, (image, slot)) in prepared.iter().zip(&bases) {
             let range = match &p.heights {
                 Some(heights) => {
-                    rec.upload_image_layer(
-                        image,
-                        vk::ImageLayout::GENERAL,
-                        0,
-                        bytemuck::cast_slice(&heights.data),
-                    )?;
+                    rec.upload_image_layer(image, 0, bytemuck::cast_slice(&heights.data))?;
                     heights.range()
                 }
                 None => {
@@ -141,12 +136,7 @@ impl Renderer<'_> {
             };
             made.insert(p.patch, (*slot, range));
         }
-        rec.memory_barrier(
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_SAMPLED_READ,
-        );
+        rec.memory_barrier(&[Access::TransferWrite], &[Access::ComputeSampled]);
         let mut bytes = 0;
         let mut ranges = None;
         if !jobs.is_empty() {
@@ -158,12 +148,8 @@ impl Renderer<'_> {
             bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
         rec.memory_barrier(
-            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::VERTEX_SHADER
-                | vk::PipelineStageFlags2::GEOMETRY_SHADER
-                | vk::PipelineStageFlags2::FRAGMENT_SHADER,
-            vk::AccessFlags2::SHADER_SAMPLED_READ,
+            &[Access::ComputeWrite, Access::TransferWrite],
+            &[Access::GraphicsSampled],
         );
 
         let mut rivers: Vec<(Image, Slot)> = Vec::new();
@@ -177,8 +163,7 @@ impl Renderer<'_> {
             }
             let slot = self.slot()?;
             let image = create_river_texture(ctx, n, &format!("river data {:?}", p.patch))?;
-            self.bindless
-                .write(ctx, slot, &image, true, vk::ImageLayout::GENERAL);
+            self.bindless.write(ctx, slot, &image, true);
             patch_jobs.push(PatchJob {
                 spacing: PatchFrame::new(p.patch, self.planet.radius, n).spacing() as f32,
                 samples: &p.samples,
@@ -201,14 +186,7 @@ impl Renderer<'_> {
                 .kernel
                 .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
             self.frames.profiler().end(rec, scope);
-            rec.memory_barrier(
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::VERTEX_SHADER
-                    | vk::PipelineStageFlags2::GEOMETRY_SHADER
-                    | vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_SAMPLED_READ,
-            );
+            rec.memory_barrier(&[Access::ComputeWrite], &[Access::GraphicsSampled]);
         }
         let river_count = rivers.len();
         let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();

@@ -13,6 +13,7 @@
 use std::mem::size_of;
 
 use super::FramePush;
+use crate::gpu::Access;
 use crate::{
     gpu::{
         pipeline::ComputePipeline, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
@@ -111,19 +112,11 @@ impl VertexCache {
             push,
             [(n * n).div_ceil(WORKGROUP), patches as u32, 1],
         );
-        rec.buffer_barrier(
-            cache,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            vk::PipelineStageFlags2::VERTEX_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_READ,
-        );
+        rec.buffer_barrier(cache, &[Access::ComputeWrite], &[Access::VertexShaderRead]);
         rec.buffer_barrier(
             water_draws,
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::SHADER_STORAGE_READ,
-            vk::PipelineStageFlags2::DRAW_INDIRECT,
-            vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            &[Access::ComputeRead, Access::ComputeWrite],
+            &[Access::IndirectCommands],
         );
     }
 

@@ -40,7 +40,7 @@ use crate::{
     gpu::{
         pipeline::RenderTarget,
         swapchain::{self, Surface, Swapchain, SWAPCHAIN_FORMAT},
-        vk, Context, ContextOptions, GpuError, Image,
+        Access, Context, ContextOptions, GpuError, Image,
     },
     kernel::gpu::KernelVariant,
     runtime::camera::Camera,
@@ -303,11 +303,8 @@ impl App<'_> {
         let stats = renderer.render_with_overlay(
             &camera,
             &target,
-            (vk::ImageLayout::UNDEFINED, vk::ImageLayout::PRESENT_SRC_KHR),
-            (
-                &[(acquired, vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)],
-                &[rendered],
-            ),
+            Access::Present,
+            (&[(acquired, Access::ColorAttachment)], &[rendered]),
             Some(&mut draw_overlay),
         )?;
         if let Some(e) = overlay_error {

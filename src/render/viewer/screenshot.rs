@@ -4,7 +4,7 @@
 
 use super::{App, ViewerError};
 use crate::{
-    gpu::{swapchain::SWAPCHAIN_FORMAT, vk},
+    gpu::{swapchain::SWAPCHAIN_FORMAT, Access},
     render::target::Offscreen,
 };
 
@@ -46,10 +46,7 @@ impl App<'_> {
                 let stats = renderer.render_with_overlay(
                     &camera,
                     &target.target([0.02, 0.03, 0.06, 1.0]),
-                    (
-                        vk::ImageLayout::UNDEFINED,
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    ),
+                    Access::ColorAttachment,
                     (&[], &[]),
                     Some(&mut draw_overlay),
                 )?;
