@@ -3,13 +3,15 @@
 //! One file per concern, as in wgpu-hal: [`access`] (the synchronisation vocabulary: every barrier names uses, not
 //! stage and access flags), [`context`] (instance, device choice, device, queue, allocator),
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
-//! [`submit`] (command recording, timeline-semaphore submissions, the staging upload path), [`frames`] (the ring of
+//! [`commands`] (everything recorded into a command buffer: uploads, copies, barriers, dispatches, draws), [`submit`]
+//! (command buffers, timeline-semaphore submissions), [`frames`] (the ring of
 //! frame contexts that keeps frames in flight), [`bindless`] (the global descriptor-indexed set), [`pipeline`]
 //! (shader modules and pipelines), [`profiler`] (timestamp scopes), [`swapchain`] (window presentation), [`overlay`]
 //! (egui's triangles, for the viewer).
 
 pub mod access;
 pub mod bindless;
+pub mod commands;
 pub mod context;
 pub mod features;
 pub mod frames;

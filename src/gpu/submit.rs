@@ -1,15 +1,12 @@
-//! Command recording and submission. Every submission signals the next value of one timeline semaphore, which
-//! orders deferred deletion and lets callers wait for exactly the work they need (never `vkDeviceWaitIdle` per
-//! upload). Uploads go through one path: a staging buffer, a copy, a barrier.
+//! Command buffers and their submission (what they record is commands.rs's). Every submission signals the next
+//! value of one timeline semaphore, which orders deferred deletion and lets callers wait for exactly the work they
+//! need (never `vkDeviceWaitIdle` per upload).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use ash::vk;
 
-use super::{
-    access::{self, Access, ImageUse},
-    Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, VkResultExt,
-};
+use super::{access::Access, Buffer, Context, GpuError, VkResultExt};
 
 /// The timeline semaphore that every submission signals.
 pub(crate) struct Timeline {
@@ -53,11 +50,11 @@ pub struct SubmissionId(pub u64);
 
 /// A command buffer being recorded, with the staging buffers its uploads use.
 pub struct Recorder<'a> {
-    ctx: &'a Context,
+    pub(super) ctx: &'a Context,
     pool: vk::CommandPool,
     pub cmd: vk::CommandBuffer,
     /// Buffers this recording uses and frees once its submission completed (staging, per-dispatch inputs).
-    owned: Vec<Buffer>,
+    pub(super) owned: Vec<Buffer>,
     /// Transient pool for per-dispatch descriptor sets.
     descriptor_pool: Option<vk::DescriptorPool>,
     /// Whether the pools belong to a frame context that resets and reuses them (`gpu::frames`); otherwise they
@@ -157,19 +154,6 @@ impl<'a> Recorder<'a> {
         self.ctx
     }
 
-    fn stage(&mut self, name: &str, data: &[u8]) -> Result<vk::Buffer, GpuError> {
-        let mut staging = self.ctx.create_buffer(&BufferDesc {
-            name: &format!("staging for {name}"),
-            size: data.len() as u64,
-            usage: vk::BufferUsageFlags::TRANSFER_SRC,
-            location: MemoryLocation::CpuToGpu,
-        })?;
-        staging.write(0, data)?;
-        let raw = staging.raw;
-        self.owned.push(staging);
-        Ok(raw)
-    }
-
     /// Keeps `buffer` alive until this recording's submission has completed, then frees it.
     pub fn free_after_completion(&mut self, buffer: Buffer) {
         self.owned.push(buffer);
@@ -225,165 +209,6 @@ impl<'a> Recorder<'a> {
         // SAFETY: the set is fresh and unused.
         unsafe { device.update_descriptor_sets(&writes, &[]) };
         Ok(set)
-    }
-
-    /// Copies `data` into `dst` at `offset` through a staging buffer, then makes it visible to shaders.
-    pub fn upload_buffer(
-        &mut self,
-        dst: &Buffer,
-        offset: u64,
-        data: &[u8],
-    ) -> Result<(), GpuError> {
-        if data.is_empty() {
-            return Ok(());
-        }
-        if offset + data.len() as u64 > dst.size {
-            return Err(GpuError::Invalid(format!(
-                "upload of {} bytes at {offset} overflows buffer '{}' of {} bytes",
-                data.len(),
-                dst.name,
-                dst.size
-            )));
-        }
-        let src = self.stage(&dst.name, data)?;
-        let region = vk::BufferCopy::default()
-            .dst_offset(offset)
-            .size(data.len() as u64);
-        // SAFETY: both buffers are alive until the submission completes (staging is retired after it).
-        unsafe {
-            self.ctx
-                .device
-                .cmd_copy_buffer(self.cmd, src, dst.raw, &[region])
-        };
-        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::AnyShaderRead]);
-        Ok(())
-    }
-
-    /// Copies tightly packed texels into array layer `layer` of `dst` through a staging buffer. The image must be in
-    /// its layout for [`Access::TransferWrite`] (after a barrier to that use).
-    pub fn upload_image_layer(
-        &mut self,
-        dst: &Image,
-        layer: u32,
-        data: &[u8],
-    ) -> Result<(), GpuError> {
-        let layout = Access::TransferWrite.layout(dst.shader_visible());
-        let src = self.stage(&dst.name, data)?;
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .base_array_layer(layer)
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: dst.extent.width,
-                height: dst.extent.height,
-                depth: 1,
-            });
-        // SAFETY: the image is in `layout` (caller's contract: the barrier before) and alive until completion.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_copy_buffer_to_image(self.cmd, src, dst.raw, layout, &[region])
-        };
-        Ok(())
-    }
-
-    /// Copies the whole of `src` (in its layout for [`Access::TransferRead`]) into `dst` at `offset`, layer after
-    /// layer, tightly packed.
-    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
-        let layout = Access::TransferRead.layout(src.shader_visible());
-        let region = vk::BufferImageCopy::default()
-            .buffer_offset(offset)
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(src.layers),
-            )
-            .image_extent(vk::Extent3D {
-                width: src.extent.width,
-                height: src.extent.height,
-                depth: 1,
-            });
-        // SAFETY: the layout is the caller's contract (the barrier before); both objects outlive the submission.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_copy_image_to_buffer(self.cmd, src.raw, layout, dst.raw, &[region])
-        };
-    }
-
-    /// Copies the first `size` bytes of `src` to `dst`, then makes them visible to the host.
-    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size: u64) {
-        let region = vk::BufferCopy::default().size(size);
-        // SAFETY: both buffers outlive the submission.
-        unsafe {
-            self.ctx
-                .device
-                .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region])
-        };
-        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::HostRead]);
-    }
-
-    /// Fills all of `buffer` with the `u32` `value` (for buffers the GPU accumulates into, e.g. with atomics).
-    pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
-        // SAFETY: recording; the buffer outlives the submission and has TRANSFER_DST usage (validated).
-        unsafe {
-            self.ctx
-                .device
-                .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
-        };
-    }
-
-    /// A barrier between the uses `before` and `after` of `buffer` (gpu/access.rs).
-    pub fn buffer_barrier(&mut self, buffer: &Buffer, before: &[Access], after: &[Access]) {
-        let barrier = [access::buffer_barrier(buffer.raw, before, after)];
-        let dep = vk::DependencyInfo::default().buffer_memory_barriers(&barrier);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
-    }
-
-    /// A barrier between the uses `before` and `after` of every resource (cheaper to write than one per resource
-    /// when many patches are involved).
-    pub fn memory_barrier(&mut self, before: &[Access], after: &[Access]) {
-        let barrier = [access::memory_barrier(before, after)];
-        let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
-    }
-
-    /// Barriers of every subresource of each of `images` for `usage`.
-    pub fn image_barriers(&mut self, images: &[&Image], usage: ImageUse) {
-        let barriers: Vec<_> = images
-            .iter()
-            .map(|image| {
-                access::image_barrier(image.raw, image.range(), image.shader_visible(), &usage)
-            })
-            .collect();
-        if barriers.is_empty() {
-            return;
-        }
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
-    }
-
-    /// A barrier of an attachment that is not one of our [`Image`]s (a swapchain image, or a render target's
-    /// image), a depth attachment if `depth`, for `usage`.
-    pub fn attachment_barrier(&mut self, image: vk::Image, depth: bool, usage: ImageUse) {
-        let range = vk::ImageSubresourceRange::default()
-            .aspect_mask(if depth {
-                vk::ImageAspectFlags::DEPTH
-            } else {
-                vk::ImageAspectFlags::COLOR
-            })
-            .level_count(1)
-            .layer_count(1);
-        let barrier = [access::image_barrier(image, range, false, &usage)];
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&barrier);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
     /// Ends recording and submits; `waits`/`signals` are binary semaphores (swapchain acquire/present).

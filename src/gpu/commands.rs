@@ -1,0 +1,379 @@
+//! Everything a [`Recorder`] records into its command buffer but timestamps and debug labels (profiler.rs,
+//! context.rs): uploads through staging buffers, copies and fills, barriers (in the uses of gpu/access.rs),
+//! dispatches, dynamic rendering and draws. Uploads go through one path: a staging buffer, a copy, a barrier. Recording and submitting the command buffer is submit.rs's job.
+
+use ash::vk;
+
+use super::{
+    access::{self, Access, ImageUse},
+    pipeline::{ComputePipeline, GraphicsPipeline, RenderTarget},
+    Buffer, BufferDesc, GpuError, Image, MemoryLocation, Recorder,
+};
+
+impl Recorder<'_> {
+    fn stage(&mut self, name: &str, data: &[u8]) -> Result<vk::Buffer, GpuError> {
+        let mut staging = self.ctx.create_buffer(&BufferDesc {
+            name: &format!("staging for {name}"),
+            size: data.len() as u64,
+            usage: vk::BufferUsageFlags::TRANSFER_SRC,
+            location: MemoryLocation::CpuToGpu,
+        })?;
+        staging.write(0, data)?;
+        let raw = staging.raw;
+        self.owned.push(staging);
+        Ok(raw)
+    }
+
+    /// Copies `data` into `dst` at `offset` through a staging buffer, then makes it visible to shaders.
+    pub fn upload_buffer(
+        &mut self,
+        dst: &Buffer,
+        offset: u64,
+        data: &[u8],
+    ) -> Result<(), GpuError> {
+        if data.is_empty() {
+            return Ok(());
+        }
+        if offset + data.len() as u64 > dst.size {
+            return Err(GpuError::Invalid(format!(
+                "upload of {} bytes at {offset} overflows buffer '{}' of {} bytes",
+                data.len(),
+                dst.name,
+                dst.size
+            )));
+        }
+        let src = self.stage(&dst.name, data)?;
+        let region = vk::BufferCopy::default()
+            .dst_offset(offset)
+            .size(data.len() as u64);
+        // SAFETY: both buffers are alive until the submission completes (staging is retired after it).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer(self.cmd, src, dst.raw, &[region])
+        };
+        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::AnyShaderRead]);
+        Ok(())
+    }
+
+    /// Copies tightly packed texels into array layer `layer` of `dst` through a staging buffer. The image must be in
+    /// its layout for [`Access::TransferWrite`] (after a barrier to that use).
+    pub fn upload_image_layer(
+        &mut self,
+        dst: &Image,
+        layer: u32,
+        data: &[u8],
+    ) -> Result<(), GpuError> {
+        let layout = Access::TransferWrite.layout(dst.shader_visible());
+        let src = self.stage(&dst.name, data)?;
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .base_array_layer(layer)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: dst.extent.width,
+                height: dst.extent.height,
+                depth: 1,
+            });
+        // SAFETY: the image is in `layout` (caller's contract: the barrier before) and alive until completion.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer_to_image(self.cmd, src, dst.raw, layout, &[region])
+        };
+        Ok(())
+    }
+
+    /// Copies the whole of `src` (in its layout for [`Access::TransferRead`]) into `dst` at `offset`, layer after
+    /// layer, tightly packed.
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        let layout = Access::TransferRead.layout(src.shader_visible());
+        let region = vk::BufferImageCopy::default()
+            .buffer_offset(offset)
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .layer_count(src.layers),
+            )
+            .image_extent(vk::Extent3D {
+                width: src.extent.width,
+                height: src.extent.height,
+                depth: 1,
+            });
+        // SAFETY: the layout is the caller's contract (the barrier before); both objects outlive the submission.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_image_to_buffer(self.cmd, src.raw, layout, dst.raw, &[region])
+        };
+    }
+
+    /// Copies the first `size` bytes of `src` to `dst`, then makes them visible to the host.
+    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size: u64) {
+        let region = vk::BufferCopy::default().size(size);
+        // SAFETY: both buffers outlive the submission.
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region])
+        };
+        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::HostRead]);
+    }
+
+    /// Fills all of `buffer` with the `u32` `value` (for buffers the GPU accumulates into, e.g. with atomics).
+    pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
+        // SAFETY: recording; the buffer outlives the submission and has TRANSFER_DST usage (validated).
+        unsafe {
+            self.ctx
+                .device
+                .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
+        };
+    }
+
+    /// A barrier between the uses `before` and `after` of `buffer` (gpu/access.rs).
+    pub fn buffer_barrier(&mut self, buffer: &Buffer, before: &[Access], after: &[Access]) {
+        let barrier = [access::buffer_barrier(buffer.raw, before, after)];
+        let dep = vk::DependencyInfo::default().buffer_memory_barriers(&barrier);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// A barrier between the uses `before` and `after` of every resource (cheaper to write than one per resource
+    /// when many patches are involved).
+    pub fn memory_barrier(&mut self, before: &[Access], after: &[Access]) {
+        let barrier = [access::memory_barrier(before, after)];
+        let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// Barriers of every subresource of each of `images` for `usage`.
+    pub fn image_barriers(&mut self, images: &[&Image], usage: ImageUse) {
+        let barriers: Vec<_> = images
+            .iter()
+            .map(|image| {
+                access::image_barrier(image.raw, image.range(), image.shader_visible(), &usage)
+            })
+            .collect();
+        if barriers.is_empty() {
+            return;
+        }
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// A barrier of an attachment that is not one of our [`Image`]s (a swapchain image, or a render target's
+    /// image), a depth attachment if `depth`, for `usage`.
+    pub fn attachment_barrier(&mut self, image: vk::Image, depth: bool, usage: ImageUse) {
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(if depth {
+                vk::ImageAspectFlags::DEPTH
+            } else {
+                vk::ImageAspectFlags::COLOR
+            })
+            .level_count(1)
+            .layer_count(1);
+        let barrier = [access::image_barrier(image, range, false, &usage)];
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barrier);
+        // SAFETY: recording.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
+    /// Binds `pipeline` with `sets` (from set 0) and `push` constants, and dispatches `groups` workgroups.
+    pub fn dispatch(
+        &mut self,
+        pipeline: &ComputePipeline,
+        sets: &[vk::DescriptorSet],
+        push: &[u8],
+        groups: [u32; 3],
+    ) {
+        self.bind(
+            vk::PipelineBindPoint::COMPUTE,
+            (pipeline.pipeline, pipeline.layout),
+            sets,
+            (vk::ShaderStageFlags::COMPUTE, push),
+        );
+        // SAFETY: recording; the pipeline is bound.
+        unsafe {
+            self.ctx()
+                .device
+                .cmd_dispatch(self.cmd, groups[0], groups[1], groups[2])
+        };
+    }
+
+    /// Binds a pipeline, its descriptor sets (from set 0) and its push constants for `stages`; empty sets or
+    /// constants are skipped.
+    fn bind(
+        &mut self,
+        point: vk::PipelineBindPoint,
+        (pipeline, layout): (vk::Pipeline, vk::PipelineLayout),
+        sets: &[vk::DescriptorSet],
+        (stages, push): (vk::ShaderStageFlags, &[u8]),
+    ) {
+        let device = &self.ctx().device;
+        // SAFETY: recording; sets and constants match the layout (validated by the layer).
+        unsafe {
+            device.cmd_bind_pipeline(self.cmd, point, pipeline);
+            if !sets.is_empty() {
+                device.cmd_bind_descriptor_sets(self.cmd, point, layout, 0, sets, &[]);
+            }
+            if !push.is_empty() {
+                device.cmd_push_constants(self.cmd, layout, stages, 0, push);
+            }
+        }
+    }
+
+    /// Begins dynamic rendering into `target` (colour in COLOR_ATTACHMENT_OPTIMAL, depth in
+    /// DEPTH_ATTACHMENT_OPTIMAL), clearing both when `clear` (depth to 0: reversed Z), and sets viewport and scissor.
+    pub fn begin_rendering(&mut self, target: &RenderTarget, clear: bool) {
+        let extent = target.extent;
+        let load = if clear {
+            vk::AttachmentLoadOp::CLEAR
+        } else {
+            vk::AttachmentLoadOp::LOAD
+        };
+        let color = [vk::RenderingAttachmentInfo::default()
+            .image_view(target.color_view)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                color: vk::ClearColorValue {
+                    float32: target.clear_color,
+                },
+            })];
+        let depth = vk::RenderingAttachmentInfo::default()
+            .image_view(target.depth_view)
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 0.0,
+                    stencil: 0,
+                },
+            });
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent,
+            })
+            .layer_count(1)
+            .color_attachments(&color)
+            .depth_attachment(&depth);
+        let device = &self.ctx().device;
+        // SAFETY: recording; attachments are in the stated layouts (caller's contract).
+        unsafe {
+            device.cmd_begin_rendering(self.cmd, &info);
+            device.cmd_set_viewport(
+                self.cmd,
+                0,
+                &[vk::Viewport {
+                    x: 0.0,
+                    y: 0.0,
+                    width: extent.width as f32,
+                    height: extent.height as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                }],
+            );
+            device.cmd_set_scissor(
+                self.cmd,
+                0,
+                &[vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                }],
+            );
+        }
+    }
+
+    pub fn end_rendering(&mut self) {
+        // SAFETY: paired with begin_rendering.
+        unsafe { self.ctx().device.cmd_end_rendering(self.cmd) };
+    }
+
+    /// Draws the instances `instances` of the indexed mesh range `range` of `indices` (u32) with `pipeline`.
+    pub fn draw_indexed(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        sets: &[vk::DescriptorSet],
+        push: &[u8],
+        indices: &super::Buffer,
+        range: std::ops::Range<u32>,
+        instances: std::ops::Range<u32>,
+    ) {
+        if range.is_empty() || instances.is_empty() {
+            return;
+        }
+        self.bind_draw(pipeline, (sets, push), indices);
+        let device = &self.ctx().device;
+        // SAFETY: recording inside a rendering scope; the pipeline is bound.
+        unsafe {
+            device.cmd_draw_indexed(
+                self.cmd,
+                range.end - range.start,
+                instances.end - instances.start,
+                range.start,
+                0,
+                instances.start,
+            );
+        }
+    }
+
+    /// Draws `count` indexed draws whose parameters the GPU wrote into `commands` (`VkDrawIndexedIndirectCommand`s
+    /// from offset 0), with `pipeline`, `sets` and `push` as [`Recorder::draw_indexed`].
+    pub fn draw_indexed_indirect(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        (sets, push): (&[vk::DescriptorSet], &[u8]),
+        indices: &super::Buffer,
+        commands: &super::Buffer,
+        count: u32,
+    ) {
+        if count == 0 {
+            return;
+        }
+        self.bind_draw(pipeline, (sets, push), indices);
+        let device = &self.ctx().device;
+        // SAFETY: recording inside a rendering scope; the pipeline is bound; multiDrawIndirect is enabled.
+        unsafe {
+            device.cmd_draw_indexed_indirect(
+                self.cmd,
+                commands.raw,
+                0,
+                count,
+                std::mem::size_of::<vk::DrawIndexedIndirectCommand>() as u32,
+            );
+        }
+    }
+
+    /// Binds a graphics pipeline with its sets and push constants (for every stage that may read them), and the
+    /// u32 index buffer `indices`.
+    fn bind_draw(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        (sets, push): (&[vk::DescriptorSet], &[u8]),
+        indices: &super::Buffer,
+    ) {
+        let stages = vk::ShaderStageFlags::VERTEX
+            | vk::ShaderStageFlags::GEOMETRY
+            | vk::ShaderStageFlags::FRAGMENT;
+        self.bind(
+            vk::PipelineBindPoint::GRAPHICS,
+            (pipeline.pipeline, pipeline.layout),
+            sets,
+            (stages, push),
+        );
+        // SAFETY: recording; the buffer holds u32 indices.
+        unsafe {
+            self.ctx()
+                .device
+                .cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32)
+        };
+    }
+}
