@@ -67,7 +67,7 @@ pub struct RefinedRanges {
 impl RefinedRanges {
     /// Each refined patch's lowest and highest height (border included), once the submission has completed; the
     /// buffer is freed.
-    pub fn read(self, ctx: &Context) -> Result<Vec<(PatchId, HeightRange)>, GpuError> {
+    pub fn read(self) -> Result<Vec<(PatchId, HeightRange)>, GpuError> {
         let ranges = self
             .buffer
             .mapped()
@@ -75,7 +75,6 @@ impl RefinedRanges {
                 bytemuck::cast_slice::<u8, [f32; 2]>(&bytes[..self.patches.len() * 8]).to_vec()
             })
             .ok_or_else(|| GpuError::Invalid("height range buffer is not host-visible".into()));
-        ctx.retire_buffer(self.buffer);
         Ok(self
             .patches
             .into_iter()
@@ -298,9 +297,7 @@ pub fn generate_on_gpu(
         for s in slots.into_values() {
             bindless.release(ctx, s);
         }
-        for i in images {
-            ctx.retire_image(i);
-        }
+        drop(images);
     };
     for p in &all {
         let Some(slot) = bindless.allocate(ctx) else {
@@ -370,7 +367,7 @@ pub fn generate_on_gpu(
     });
     let out = result.and_then(|ranges| {
         let ranges = match ranges {
-            Some(r) => r.read(ctx)?.into_iter().collect(),
+            Some(r) => r.read()?.into_iter().collect(),
             None => HashMap::new(),
         };
         let bytes = readback
@@ -392,7 +389,6 @@ pub fn generate_on_gpu(
             .collect();
         Ok(GpuPatches { heights, ranges })
     });
-    ctx.retire_buffer(readback);
     release(images, slots, bindless);
     out
 }

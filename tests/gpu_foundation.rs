@@ -5,7 +5,7 @@ mod common;
 use riverplanet::{
     gpu::{
         pipeline::{BufferSetLayout, ComputePipeline},
-        vk, Access, BufferDesc, MemoryLocation, Profiler,
+        vk, Access, BufferDesc, ImageDesc, ImageUse, MemoryLocation, Profiler,
     },
     shaders,
 };
@@ -69,8 +69,8 @@ fn compute_dispatch_reads_back_and_is_timed() {
     profiler.destroy(ctx);
     pipeline.destroy(ctx);
     sets.destroy(ctx);
-    ctx.retire_buffer(out);
-    ctx.retire_buffer(readback);
+    drop(out);
+    drop(readback);
     ctx.wait_idle().unwrap();
     common::assert_no_validation_errors(ctx);
 }
@@ -106,8 +106,62 @@ fn staging_upload_reaches_device_local_buffer() {
     .unwrap();
     let back: &[u32] = bytemuck::cast_slice(readback.mapped().unwrap());
     assert_eq!(back, &data[..]);
-    ctx.retire_buffer(device_local);
-    ctx.retire_buffer(readback);
+    drop(device_local);
+    drop(readback);
     ctx.wait_idle().unwrap();
     common::assert_no_validation_errors(ctx);
+}
+
+/// Dropping a buffer or an image retires it: it stays allocated while a submission that used it may run, and is
+/// freed once the GPU is done, without a call to free it.
+#[test]
+fn dropped_buffers_and_images_are_freed_once_the_gpu_is_done() {
+    if common::gpu().is_none() {
+        return;
+    }
+    // A context of its own: the shared one's allocations change with the other tests.
+    let ctx =
+        riverplanet::gpu::Context::new(&riverplanet::gpu::ContextOptions::from_env()).unwrap();
+    let before = ctx.live_allocations();
+    let buffer = ctx
+        .create_buffer(&BufferDesc {
+            name: "dropped buffer",
+            size: 1 << 20,
+            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        })
+        .unwrap();
+    let image = ctx
+        .create_image(&ImageDesc {
+            name: "dropped image",
+            extent: vk::Extent2D {
+                width: 64,
+                height: 64,
+            },
+            layers: 1,
+            format: vk::Format::R32_SFLOAT,
+            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+            aspect: vk::ImageAspectFlags::COLOR,
+            array: false,
+        })
+        .unwrap();
+    assert_eq!(ctx.live_allocations(), before + 2);
+    let mut rec = riverplanet::gpu::Recorder::begin(&ctx, "fill before drop").unwrap();
+    rec.fill_buffer(&buffer, 7);
+    rec.image_barriers(
+        &[&image],
+        ImageUse {
+            before: &[Access::Nothing],
+            after: &[Access::TransferWrite],
+            discard: true,
+        },
+    );
+    let submitted = rec.submit().unwrap();
+    drop(buffer);
+    drop(image);
+    // Retired, not freed: the submission may still use them.
+    assert_eq!(ctx.live_allocations(), before + 2);
+    ctx.wait(submitted).unwrap();
+    ctx.collect_garbage();
+    assert_eq!(ctx.live_allocations(), before);
 }

@@ -612,7 +612,7 @@ fn the_exported_surface_is_the_surface_the_renderer_draws() {
     renderer.render_until_streamed(&camera, &clear, 1).unwrap();
     let capture = renderer.last_capture.take().unwrap();
     renderer.destroy();
-    offscreen.destroy(ctx);
+    drop(offscreen);
     common::assert_no_validation_errors(ctx);
 
     let unmorphed: Vec<_> = capture.drawn().filter(|v| v.morph == 0.0).collect();

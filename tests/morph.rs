@@ -128,7 +128,6 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
         altitude *= 0.9975;
     }
     renderer.destroy();
-    offscreen.destroy(ctx);
     (largest, compared)
 }
 

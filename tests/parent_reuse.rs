@@ -209,7 +209,6 @@ fn ground_vertices(parent_reuse: bool) -> Option<(VertexCapture, usize)> {
     renderer.render_until_streamed(&camera, &target, 1).unwrap();
     let capture = renderer.last_capture.take().unwrap();
     renderer.destroy();
-    offscreen.destroy(ctx);
     common::assert_no_validation_errors(ctx);
     Some((capture, from_parent))
 }

@@ -67,7 +67,6 @@ fn two_metres_above_an_earth_sized_river_vertices_are_exact_to_a_millimetre_and_
     frame(&mut renderer, &camera_at(side), true, 1);
     let after = renderer.last_capture.take().unwrap();
     renderer.destroy();
-    offscreen.destroy(ctx);
     assert!(
         deepest >= 20,
         "deepest level {deepest} two metres above the water"

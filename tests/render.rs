@@ -200,7 +200,7 @@ fn render_cleared(
         .unwrap();
     let image = target.read(ctx).unwrap();
     renderer.destroy();
-    target.destroy(ctx);
+    drop(target);
     image
 }
 

@@ -296,7 +296,6 @@ fn fly(
         Ok(())
     })();
     renderer.destroy();
-    target.destroy(ctx);
     result.map(|()| frames)
 }
 

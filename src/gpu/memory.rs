@@ -1,8 +1,9 @@
-//! Named buffers and images on gpu-allocator memory, and deferred destruction: a retired resource is freed only
-//! after the GPU has finished every submission made before it was retired (Granite's per-frame lists, keyed here
-//! by timeline-semaphore value).
+//! Named buffers and images on gpu-allocator memory, and deferred destruction: a dropped buffer or image (or a
+//! retired pool) is freed only after the GPU has finished every submission made before it was dropped (Granite's
+//! per-frame lists, keyed here by timeline-semaphore value). Dropping is retiring, so none can leak by being
+//! forgotten.
 
-use std::sync::Mutex;
+use std::sync::{atomic::AtomicU64, Arc, Mutex};
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
@@ -24,6 +25,14 @@ pub struct Buffer {
     pub size: u64,
     pub name: String,
     allocation: Option<Allocation>,
+    deletion: Arc<DeletionQueue>,
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        self.deletion
+            .retire(Retired::Buffer(self.raw, self.allocation.take()));
+    }
 }
 
 impl Buffer {
@@ -89,6 +98,14 @@ pub struct Image {
     pub name: String,
     usage: vk::ImageUsageFlags,
     allocation: Option<Allocation>,
+    deletion: Arc<DeletionQueue>,
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        self.deletion
+            .retire(Retired::Image(self.raw, self.view, self.allocation.take()));
+    }
 }
 
 impl Image {
@@ -120,14 +137,23 @@ enum Retired {
     QueryPool(vk::QueryPool),
 }
 
-/// Resources waiting for the GPU to finish with them, each tagged with the timeline value that must complete first.
-#[derive(Default)]
+/// Resources waiting for the GPU to finish with them, each tagged with the timeline value that must complete first:
+/// the last one submitted when it was retired (`submitted`, shared with the timeline).
 pub(crate) struct DeletionQueue {
     pending: Mutex<Vec<(u64, Retired)>>,
+    submitted: Arc<AtomicU64>,
 }
 
 impl DeletionQueue {
-    fn push(&self, after: u64, item: Retired) {
+    pub(crate) fn new(submitted: Arc<AtomicU64>) -> Self {
+        Self {
+            pending: Mutex::new(Vec::new()),
+            submitted,
+        }
+    }
+
+    fn retire(&self, item: Retired) {
+        let after = self.submitted.load(std::sync::atomic::Ordering::Acquire);
         self.pending
             .lock()
             .unwrap_or_else(|e| e.into_inner())
@@ -228,6 +254,7 @@ impl Context {
             size: desc.size,
             name: desc.name.to_string(),
             allocation: Some(allocation),
+            deletion: self.deletion.clone(),
         })
     }
 
@@ -290,40 +317,30 @@ impl Context {
             name: desc.name.to_string(),
             usage: desc.usage,
             allocation: Some(allocation),
+            deletion: self.deletion.clone(),
         })
     }
 
-    /// Frees `buffer` once every submission made so far has completed.
-    pub fn retire_buffer(&self, mut buffer: Buffer) {
-        self.deletion.push(
-            self.timeline.last_submitted(),
-            Retired::Buffer(buffer.raw, buffer.allocation.take()),
-        );
-    }
-
-    /// Frees `image` once every submission made so far has completed.
-    pub fn retire_image(&self, mut image: Image) {
-        self.deletion.push(
-            self.timeline.last_submitted(),
-            Retired::Image(image.raw, image.view, image.allocation.take()),
-        );
-    }
-
     pub(crate) fn retire_command_pool(&self, pool: vk::CommandPool) {
-        self.deletion
-            .push(self.timeline.last_submitted(), Retired::Pool(pool));
+        self.deletion.retire(Retired::Pool(pool));
     }
 
     pub(crate) fn retire_descriptor_pool(&self, pool: vk::DescriptorPool) {
-        self.deletion.push(
-            self.timeline.last_submitted(),
-            Retired::DescriptorPool(pool),
-        );
+        self.deletion.retire(Retired::DescriptorPool(pool));
     }
 
     pub(crate) fn retire_query_pool(&self, pool: vk::QueryPool) {
-        self.deletion
-            .push(self.timeline.last_submitted(), Retired::QueryPool(pool));
+        self.deletion.retire(Retired::QueryPool(pool));
+    }
+
+    /// How many buffers and images hold memory (live, or retired and not yet freed): for leak checks.
+    pub fn live_allocations(&self) -> usize {
+        self.allocator
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .generate_report()
+            .allocations
+            .len()
     }
 
     /// Frees retired resources whose submissions have completed. Cheap; call once per frame.

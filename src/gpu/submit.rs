@@ -2,7 +2,10 @@
 //! value of one timeline semaphore, which orders deferred deletion and lets callers wait for exactly the work they
 //! need (never `vkDeviceWaitIdle` per upload).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{
+    atomic::{AtomicU64, Ordering},
+    Arc,
+};
 
 use ash::vk;
 
@@ -11,7 +14,8 @@ use super::{access::Access, Buffer, Context, GpuError, VkResultExt};
 /// The timeline semaphore that every submission signals.
 pub(crate) struct Timeline {
     semaphore: vk::Semaphore,
-    last: AtomicU64,
+    /// The last value submitted; the deletion queue tags what is retired with it.
+    pub(crate) last: Arc<AtomicU64>,
 }
 
 impl Timeline {
@@ -24,7 +28,7 @@ impl Timeline {
         let semaphore = unsafe { device.create_semaphore(&info, None) }.vk("vkCreateSemaphore")?;
         Ok(Self {
             semaphore,
-            last: AtomicU64::new(0),
+            last: Arc::new(AtomicU64::new(0)),
         })
     }
 
@@ -262,9 +266,8 @@ impl<'a> Recorder<'a> {
                 ctx.retire_descriptor_pool(pool);
             }
         }
-        for buffer in self.owned {
-            ctx.retire_buffer(buffer);
-        }
+        // Staging and per-dispatch buffers: retired now, after this submission's value, so freed once it completes.
+        drop(self.owned);
         Ok(SubmissionId(value))
     }
 

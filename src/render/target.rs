@@ -94,13 +94,7 @@ impl Offscreen {
             image::RgbaImage::from_raw(w, h, pixels)
                 .ok_or_else(|| GpuError::Invalid("readback size mismatch".into()))
         });
-        ctx.retire_buffer(buffer);
         image
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        ctx.retire_image(self.color);
-        ctx.retire_image(self.depth);
     }
 }
 

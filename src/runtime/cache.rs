@@ -188,11 +188,10 @@ impl PatchCache {
     }
 }
 
+/// Frees `data`'s bindless slots; its images are retired as it drops.
 fn release(ctx: &Context, bindless: &mut Bindless, data: PatchData) {
     bindless.release(ctx, data.base_slot);
-    ctx.retire_image(data.base);
-    if let Some((image, slot)) = data.river {
+    if let Some((_, slot)) = data.river {
         bindless.release(ctx, slot);
-        ctx.retire_image(image);
     }
 }

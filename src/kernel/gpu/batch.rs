@@ -100,15 +100,12 @@ impl BatchOutputs {
         (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
     }
 
-    /// Frees the textures (after the GPU is done with them) and their slots.
+    /// Frees the textures' slots; the textures and the read-back buffer are retired as `self` drops (freed once
+    /// the GPU is done with them).
     pub fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
         for s in self.slots {
             bindless.release(ctx, s);
         }
-        for i in self.images {
-            ctx.retire_image(i);
-        }
-        ctx.retire_buffer(self.readback);
     }
 }
 

@@ -13,9 +13,7 @@ use super::{
 };
 use crate::gpu::{Access, ImageUse};
 use crate::{
-    gpu::{
-        pipeline::RenderTarget, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
-    },
+    gpu::{pipeline::RenderTarget, vk, Buffer, BufferDesc, GpuError, MemoryLocation, Recorder},
     planet::cube::{PatchId, EDGES},
     runtime::{camera::Camera, lod::Selected},
 };
@@ -74,17 +72,11 @@ pub(super) struct Drawn {
 
 impl Drawn {
     /// The captured vertices, once the frame has completed (the buffer is freed).
-    pub(super) fn read_capture(
-        self,
-        ctx: &Context,
-        camera: DVec3,
-        n: u32,
-    ) -> Option<VertexCapture> {
-        let buffer = self.capture?;
-        let positions: Option<Vec<[f32; 4]>> = buffer
+    pub(super) fn read_capture(self, camera: DVec3, n: u32) -> Option<VertexCapture> {
+        let positions: Option<Vec<[f32; 4]>> = self
+            .capture?
             .mapped()
             .map(|bytes| bytemuck::cast_slice(bytes).to_vec());
-        ctx.retire_buffer(buffer);
         let per = mesh_vertices(n) as usize;
         positions.map(|p| VertexCapture {
             camera,

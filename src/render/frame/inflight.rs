@@ -74,11 +74,11 @@ impl Renderer<'_> {
         } in finished
         {
             if let Some(ranges) = payload.ranges {
-                for (patch, range) in ranges.read(self.ctx)? {
+                for (patch, range) in ranges.read()? {
                     self.cache.set_height_range(&patch, range);
                 }
             }
-            if let Some(capture) = payload.drawn.read_capture(self.ctx, payload.camera, n) {
+            if let Some(capture) = payload.drawn.read_capture(payload.camera, n) {
                 self.last_capture = Some(capture);
             }
             let mut ms = BTreeMap::new();

@@ -536,12 +536,11 @@ impl<'w> Renderer<'w> {
         })
     }
 
-    /// Frees every GPU object of the renderer (after the device is idle).
+    /// Frees every GPU object of the renderer (after the device is idle); its buffers are retired as it drops.
     pub fn destroy(mut self) {
         let ctx = self.ctx;
         let _ = ctx.wait_idle();
         self.cache.clear(ctx, &mut self.bindless);
-        ctx.retire_buffer(self.indices);
         self.frames.destroy(ctx);
         self.kernel.destroy(ctx);
         self.refiner.destroy(ctx);
@@ -553,7 +552,6 @@ impl<'w> Renderer<'w> {
         }
         self.instance_layout.destroy(ctx);
         self.vertex_cache.destroy(ctx);
-        ctx.retire_buffer(self.no_capture);
         let _ = ctx.wait_idle();
         self.bindless.destroy(ctx);
     }

@@ -20,7 +20,8 @@ const RINGS: u32 = 48;
 const SEGMENTS: u32 = 96;
 
 pub(super) struct Sky {
-    table: Image,
+    /// The atmosphere's table, held while `slot` points at it (retired as the sky drops).
+    _table: Image,
     slot: Slot,
     pipeline: GraphicsPipeline,
     /// The dome's triangles: vertex `ring * (SEGMENTS + 1) + segment`.
@@ -99,7 +100,7 @@ impl Sky {
             },
         )?;
         Ok(Self {
-            table: image,
+            _table: image,
             slot,
             pipeline,
             dome,
@@ -127,8 +128,6 @@ impl Sky {
 
     pub(super) fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
         self.pipeline.destroy(ctx);
-        ctx.retire_buffer(self.dome);
-        ctx.retire_image(self.table);
         bindless.release(ctx, self.slot);
     }
 }

@@ -228,9 +228,7 @@ impl App<'_> {
         if let Some(old) = self.swapchain.take() {
             old.destroy(self.ctx);
         }
-        if let Some(depth) = self.depth.take() {
-            self.ctx.retire_image(depth);
-        }
+        self.depth = None;
         let swapchain = Swapchain::new(self.ctx, surface, width, height)?;
         self.depth = Some(create_depth(self.ctx, swapchain.extent)?);
         self.swapchain = Some(swapchain);
@@ -367,9 +365,7 @@ impl App<'_> {
         if let Some(swapchain) = self.swapchain.take() {
             swapchain.destroy(self.ctx);
         }
-        if let Some(depth) = self.depth.take() {
-            self.ctx.retire_image(depth);
-        }
+        self.depth = None;
         if let Some(surface) = self.surface.take() {
             surface.destroy();
         }

@@ -56,7 +56,6 @@ impl App<'_> {
             }
             target.read(self.ctx)
         })();
-        target.destroy(self.ctx);
         let image = result?;
         crate::export::files::save_image(&image, path).map_err(|e| screenshot_error(path, e))?;
         let sidecar = path.with_extension("json");
