@@ -155,7 +155,7 @@ fn plot(
 }
 
 fn info(options: &ContextOptions, json: bool) -> ExitCode {
-    let (version, adapters) = match gpu::context::enumerate(options) {
+    let (version, adapters) = match gpu::adapter::enumerate(options) {
         Ok(v) => v,
         Err(e) => {
             eprintln!("error: {e}");

@@ -1,19 +1,19 @@
-//! Instance, debug messenger, physical-device choice, logical device, queue and memory allocator.
+//! The context: instance, logical device, queue, memory allocator and deferred deletion, created in that order and
+//! destroyed in reverse. Choosing the device is adapter.rs's job; the debug messenger and object names debug.rs's.
 
-use std::{
-    ffi::{c_void, CStr},
-    mem::ManuallyDrop,
-    sync::Mutex,
-};
+use std::{ffi::CStr, mem::ManuallyDrop, sync::Mutex};
 
 use ash::{ext, vk};
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::{
-    features, memory::DeletionQueue, submit::Timeline, FeatureReport, GpuError, VkResultExt,
+    adapter::{choose, graphics_compute_family, AdapterInfo},
+    debug::{self, ValidationLog, VALIDATION_LAYER},
+    features,
+    memory::DeletionQueue,
+    submit::Timeline,
+    GpuError, VkResultExt,
 };
-
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to create a [`Context`].
 #[derive(Clone, Debug, Default)]
@@ -51,42 +51,13 @@ impl ContextOptions {
     }
 }
 
-/// What `riverplanet info` shows of one physical device.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct AdapterInfo {
-    pub name: String,
-    pub device_type: String,
-    pub api_version: String,
-    pub driver_name: String,
-    pub driver_info: String,
-    pub features: FeatureReport,
-    pub chosen: bool,
-}
-
-/// Validation messages collected by the debug messenger. Errors make every GPU test fail.
-#[derive(Default)]
-pub struct ValidationLog {
-    errors: Mutex<Vec<String>>,
-    /// Synchronization hazards reported through the bindless set's runtime arrays, which are not counted as errors
-    /// (`is_runtime_array_hazard`).
-    waived: std::sync::atomic::AtomicUsize,
-}
-
-/// Whether `message` is a synchronization hazard that validation layers before 1.3.268 report for every element of
-/// a runtime descriptor array the pipeline declares, accessed or not (Vulkan-ValidationLayers issue 3450): every
-/// dispatch and draw that binds the bindless set would "write" every patch texture. Later layers skip runtime
-/// arrays in synchronization validation altogether (pull request 6605), so waiving them checks what they check.
-fn is_runtime_array_hazard(message: &str) -> bool {
-    message.contains("SYNC-HAZARD") && message.contains(&format!("[{}]", super::bindless::SET_NAME))
-}
-
 /// The device and everything needed to use it. Shared by reference; internally synchronised.
 pub struct Context {
     pub(crate) entry: ash::Entry,
     pub instance: ash::Instance,
     debug_instance: Option<ext::debug_utils::Instance>,
     messenger: vk::DebugUtilsMessengerEXT,
-    debug_device: Option<ext::debug_utils::Device>,
+    pub(super) debug_device: Option<ext::debug_utils::Device>,
     pub physical: vk::PhysicalDevice,
     pub device: ash::Device,
     pub queue_family: u32,
@@ -97,17 +68,17 @@ pub struct Context {
     pub properties: vk::PhysicalDeviceProperties,
     pub subgroup: features::SubgroupProperties,
     pub timestamp_valid_bits: u32,
-    validation_log: Box<ValidationLog>,
-    validation_enabled: bool,
+    pub(super) validation_log: Box<ValidationLog>,
+    pub(super) validation_enabled: bool,
     pub adapter: AdapterInfo,
 }
 
-fn load_entry() -> Result<ash::Entry, GpuError> {
+pub(super) fn load_entry() -> Result<ash::Entry, GpuError> {
     // SAFETY: loading libvulkan runs its initialisers; nothing else of ours runs concurrently with it here.
     unsafe { ash::Entry::load() }.map_err(|e| GpuError::Loader(e.to_string()))
 }
 
-fn create_instance(
+pub(super) fn create_instance(
     entry: &ash::Entry,
     options: &ContextOptions,
 ) -> Result<(ash::Instance, bool), GpuError> {
@@ -162,152 +133,6 @@ fn create_instance(
     // SAFETY: every pointer in `info` outlives the call.
     let instance = unsafe { entry.create_instance(&info, None) }.vk("vkCreateInstance")?;
     Ok((instance, validation && has_debug_utils))
-}
-
-unsafe extern "system" fn debug_callback(
-    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    kind: vk::DebugUtilsMessageTypeFlagsEXT,
-    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
-    user: *mut c_void,
-) -> vk::Bool32 {
-    // Never unwind across FFI: a panic here is caught and dropped.
-    let _ = std::panic::catch_unwind(|| {
-        // SAFETY: the layer passes valid callback data for the duration of the call.
-        let message = unsafe { data.as_ref() }
-            .and_then(|d| unsafe { d.message_as_c_str() })
-            .map(|m| m.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        // SAFETY: `user` is the boxed ValidationLog owned by the Context, alive until the messenger is destroyed.
-        let validation_log = unsafe { (user as *const ValidationLog).as_ref() };
-        if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-            if is_runtime_array_hazard(&message) {
-                log::debug!("[vulkan {kind:?}] waived (runtime descriptor array): {message}");
-                if let Some(log) = validation_log {
-                    log.waived
-                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                }
-                return;
-            }
-            log::error!("[vulkan {kind:?}] {message}");
-            if let Some(log) = validation_log {
-                if let Ok(mut errors) = log.errors.lock() {
-                    errors.push(message);
-                }
-            }
-        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
-            log::warn!("[vulkan {kind:?}] {message}");
-        } else {
-            log::debug!("[vulkan {kind:?}] {message}");
-        }
-    });
-    vk::FALSE
-}
-
-fn graphics_compute_family(instance: &ash::Instance, physical: vk::PhysicalDevice) -> Option<u32> {
-    // SAFETY: plain query.
-    let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-    families
-        .iter()
-        .position(|f| {
-            f.queue_flags
-                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-        })
-        .map(|i| i as u32)
-}
-
-fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice) -> AdapterInfo {
-    let mut driver = vk::PhysicalDeviceDriverProperties::default();
-    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-    // SAFETY: plain query with a chain on this stack frame.
-    unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
-    let p = props2.properties;
-    let v = p.api_version;
-    let family = graphics_compute_family(instance, physical);
-    AdapterInfo {
-        name: p
-            .device_name_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        device_type: format!("{:?}", p.device_type),
-        api_version: format!(
-            "{}.{}.{}",
-            vk::api_version_major(v),
-            vk::api_version_minor(v),
-            vk::api_version_patch(v)
-        ),
-        driver_name: driver
-            .driver_name_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        driver_info: driver
-            .driver_info_as_c_str()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        features: features::query(instance, physical, family),
-        chosen: false,
-    }
-}
-
-fn type_rank(device_type: &str) -> u32 {
-    match device_type {
-        "DISCRETE_GPU" => 4,
-        "INTEGRATED_GPU" => 3,
-        "VIRTUAL_GPU" => 2,
-        "CPU" => 1,
-        _ => 0,
-    }
-}
-
-/// Every device's description, its handle, and the index of the chosen one.
-type Enumeration = (Vec<AdapterInfo>, Vec<vk::PhysicalDevice>, Option<usize>);
-
-/// Lists every device and marks the one `options` chooses: the adapter filter first, then discrete GPUs before
-/// integrated, virtual and CPU devices, among devices with every required feature.
-fn choose(instance: &ash::Instance, options: &ContextOptions) -> Result<Enumeration, GpuError> {
-    // SAFETY: plain query.
-    let physicals =
-        unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
-    let mut infos: Vec<AdapterInfo> = physicals.iter().map(|&p| describe(instance, p)).collect();
-    let matches = |info: &AdapterInfo| match &options.adapter {
-        Some(f) => info.name.to_lowercase().contains(&f.to_lowercase()),
-        None => true,
-    };
-    let chosen = infos
-        .iter()
-        .enumerate()
-        .filter(|(_, i)| matches(i))
-        .max_by_key(|(_, i)| (i.features.all_supported(), type_rank(&i.device_type)))
-        .map(|(idx, _)| idx);
-    if let Some(idx) = chosen {
-        infos[idx].chosen = true;
-    }
-    Ok((infos, physicals, chosen))
-}
-
-/// Lists the devices without creating one (for `riverplanet info`). Returns the instance version too.
-pub fn enumerate(options: &ContextOptions) -> Result<(String, Vec<AdapterInfo>), GpuError> {
-    let entry = load_entry()?;
-    // SAFETY: plain query.
-    let version = unsafe { entry.try_enumerate_instance_version() }
-        .vk("vkEnumerateInstanceVersion")?
-        .unwrap_or(vk::API_VERSION_1_0);
-    let (instance, _) = create_instance(
-        &entry,
-        &ContextOptions {
-            validation: false,
-            ..options.clone()
-        },
-    )?;
-    let result = choose(&instance, options).map(|(infos, _, _)| infos);
-    // SAFETY: nothing was created from this instance.
-    unsafe { instance.destroy_instance(None) };
-    let version = format!(
-        "{}.{}.{}",
-        vk::api_version_major(version),
-        vk::api_version_minor(version),
-        vk::api_version_patch(version)
-    );
-    Ok((version, result?))
 }
 
 impl Context {
@@ -373,22 +198,7 @@ impl Context {
 
         let validation_log = Box::<ValidationLog>::default();
         let (debug_instance, messenger) = if validation_enabled {
-            let debug = ext::debug_utils::Instance::new(&entry, &instance);
-            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-                .message_severity(
-                    vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                        | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-                )
-                .message_type(
-                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
-                )
-                .pfn_user_callback(Some(debug_callback))
-                .user_data(&*validation_log as *const ValidationLog as *mut c_void);
-            // SAFETY: the user data box outlives the messenger (destroyed first in Drop).
-            let messenger = unsafe { debug.create_debug_utils_messenger(&info, None) }
-                .vk("vkCreateDebugUtilsMessengerEXT")?;
+            let (debug, messenger) = debug::messenger(&entry, &instance, &validation_log)?;
             (Some(debug), messenger)
         } else {
             (None, vk::DebugUtilsMessengerEXT::null())
@@ -470,63 +280,6 @@ impl Context {
             validation_enabled,
             adapter,
         })
-    }
-
-    /// Whether the validation layer is active (and its errors are being collected).
-    pub fn validation_enabled(&self) -> bool {
-        self.validation_enabled
-    }
-
-    /// Synchronization hazards waived so far because they were reported through the bindless set's runtime arrays
-    /// (`is_runtime_array_hazard`).
-    pub fn waived_validation_messages(&self) -> usize {
-        self.validation_log
-            .waived
-            .load(std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// Validation errors reported so far. GPU tests assert this is empty.
-    pub fn validation_errors(&self) -> Vec<String> {
-        self.validation_log
-            .errors
-            .lock()
-            .map(|e| e.clone())
-            .unwrap_or_default()
-    }
-
-    /// Gives `handle` a name for validation messages and capture tools (RenderDoc).
-    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
-        let Some(debug) = &self.debug_device else {
-            return;
-        };
-        let Ok(name) = std::ffi::CString::new(name) else {
-            return;
-        };
-        let info = vk::DebugUtilsObjectNameInfoEXT::default()
-            .object_handle(handle)
-            .object_name(&name);
-        // SAFETY: the handle belongs to this device; naming failure is harmless, so the result is ignored.
-        let _ = unsafe { debug.set_debug_utils_object_name(&info) };
-    }
-
-    /// Opens a debug label region in `cmd` (shown by capture tools); close it with [`Self::end_label`].
-    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
-        let Some(debug) = &self.debug_device else {
-            return;
-        };
-        let Ok(name) = std::ffi::CString::new(name) else {
-            return;
-        };
-        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
-        // SAFETY: cmd is recording.
-        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
-    }
-
-    pub fn end_label(&self, cmd: vk::CommandBuffer) {
-        if let Some(debug) = &self.debug_device {
-            // SAFETY: paired with begin_label on a recording command buffer.
-            unsafe { debug.cmd_end_debug_utils_label(cmd) };
-        }
     }
 
     pub(crate) fn queue(&self) -> std::sync::MutexGuard<'_, vk::Queue> {

@@ -1,7 +1,7 @@
 //! The Vulkan backend: the only module that imports `ash`. It knows nothing of planets.
 //!
 //! One file per concern, as in wgpu-hal: [`access`] (the synchronisation vocabulary: every barrier names uses, not
-//! stage and access flags), [`context`] (instance, device choice, device, queue, allocator),
+//! stage and access flags), [`adapter`] (describing the devices and choosing one), [`context`] (instance, device, queue, allocator), `debug` (validation messages, object names, labels),
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
 //! [`commands`] (everything recorded into a command buffer: uploads, copies, barriers, dispatches, draws), [`submit`]
 //! (command buffers, timeline-semaphore submissions), [`frames`] (the ring of
@@ -10,9 +10,11 @@
 //! (egui's triangles, for the viewer).
 
 pub mod access;
+pub mod adapter;
 pub mod bindless;
 pub mod commands;
 pub mod context;
+mod debug;
 pub mod features;
 pub mod frames;
 pub mod memory;
@@ -23,8 +25,9 @@ pub mod submit;
 pub mod swapchain;
 
 pub use access::{Access, ImageUse};
+pub use adapter::AdapterInfo;
 pub use ash::vk;
-pub use context::{AdapterInfo, Context, ContextOptions};
+pub use context::{Context, ContextOptions};
 pub use features::FeatureReport;
 pub use memory::{Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};
 pub use profiler::{Profiler, ScopeTiming};

@@ -5,22 +5,25 @@
 
 mod draw;
 mod inflight;
+mod modes;
 mod plan;
 mod shader_data;
 mod sky;
+mod stats;
 mod upload;
 mod vertex_cache;
 
 use std::{collections::BTreeMap, time::Instant};
 
 use glam::DVec3;
-use serde::Serialize;
 
 pub use self::draw::{DrawnVertex, VertexCapture};
 pub use self::inflight::GpuTimes;
 use self::inflight::{InFlight, TIMESTAMP_SCOPES};
+pub use self::modes::{ViewMode, WaterMode};
 use self::shader_data::FramePush;
 pub use self::shader_data::PatchInstance;
+pub use self::stats::FrameStats;
 use super::mesh::{index_buffer, patch_mesh, PatchMesh, QuadrantMesh};
 use crate::{
     config::{Config, LodRule},
@@ -49,110 +52,14 @@ use crate::{
 /// Draws recorded into a frame's rendering after its own passes (the viewer's overlay).
 pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, vk::Extent2D);
 
-/// How rivers are drawn (Section 8.4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum WaterMode {
-    /// The thesis's rule: water geometry where the mesh resolves the river, painted elsewhere.
-    Auto,
-    /// Always emit water triangles in river basins.
-    Geometry,
-    /// Always paint rivers in the fragment shader (sea water stays geometry).
-    Painted,
-}
-
-impl crate::named::Named for WaterMode {
-    const ALL: &'static [(&'static str, Self)] = &[
-        ("auto", Self::Auto),
-        ("geometry", Self::Geometry),
-        ("painted", Self::Painted),
-    ];
-}
-
-impl crate::named::Named for ViewMode {
-    const ALL: &'static [(&'static str, Self)] = &[
-        ("shaded", Self::Shaded),
-        ("lod", Self::Lod),
-        ("painted-red", Self::PaintedRed),
-    ];
-}
-
-impl WaterMode {
-    pub fn next(self) -> Self {
-        match self {
-            WaterMode::Auto => WaterMode::Geometry,
-            WaterMode::Geometry => WaterMode::Painted,
-            WaterMode::Painted => WaterMode::Auto,
-        }
-    }
-}
-
 /// The mountain height the fragment shader's colour bands are drawn for (Appendix A's `max-mountain-height`);
 /// other planets scale the bands by their own mountain height.
 const COLOUR_BAND_MOUNTAIN_HEIGHT: f32 = 16.0;
-
-/// What the fragment shader shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ViewMode {
-    Shaded,
-    /// Patches tinted by level of detail.
-    Lod,
-    /// Painted rivers in red (as in the thesis's Fig. 9.9).
-    PaintedRed,
-}
-
-/// What one frame did, for the viewer, the benchmarks and the plots (Chapter 9).
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct FrameStats {
-    pub frame: u64,
-    /// Patches selected by the level of detail (before culling).
-    pub selected_patches: usize,
-    pub visible_patches: usize,
-    pub new_patches: usize,
-    /// New patches influenced by rivers (computed by the kernel this frame).
-    pub river_patches: usize,
-    /// Of those, patches that took their even vertices from their parent (10.2).
-    pub river_patches_from_parent: usize,
-    /// Visible patches drawn with an ancestor's data because theirs has not arrived yet.
-    pub fallback_patches: usize,
-    /// Patches still waiting for data after this frame.
-    pub pending_patches: usize,
-    /// The finest level drawn with its own data.
-    pub deepest_level: u32,
-    /// Triangles the terrain pass draws (the patches' quadrants with their skirts; the water pass spawns its own).
-    pub terrain_triangles: u64,
-    pub samples: usize,
-    pub resident_patches: usize,
-    pub evicted_patches: usize,
-    pub patch_texture_bytes: u64,
-    pub temporary_sample_bytes: u64,
-    pub precomputed_height_bytes: u64,
-    pub memory_bytes: u64,
-    pub cpu_ms: BTreeMap<String, f64>,
-    /// GPU time per pass of frame `gpu_frame`: the latest that finished by the end of this call, one or two
-    /// frames before this one (frames in flight); empty until the first has finished.
-    pub gpu_ms: BTreeMap<String, f64>,
-    pub gpu_frame: u64,
-    /// Frames submitted and not yet finished on the GPU when this call returned (this one included).
-    pub frames_in_flight: usize,
-    /// The newest frame the CPU had waited for (or seen finished) before submitting this one: with two frames in
-    /// flight, the frame two back, so the previous frame was still queued while this one was recorded.
-    pub synchronized_frame: u64,
-    pub frame_ms: f64,
-}
 
 /// Bytes of the largest resident patch: its base-height texture and a river texture.
 fn max_patch_bytes(n: u32) -> usize {
     let side = crate::planet::detail::PatchHeights::side(n);
     side * side * 4 + (n * n) as usize * 16 * crate::kernel::gpu::RIVER_TEXTURE_LAYERS as usize
-}
-
-impl FrameStats {
-    /// Whether every visible patch was drawn with its own data and nothing is left to make.
-    pub fn streamed(&self) -> bool {
-        self.pending_patches == 0 && self.fallback_patches == 0 && self.new_patches == 0
-    }
 }
 
 fn ms_since(t: Instant) -> f64 {
