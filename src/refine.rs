@@ -6,19 +6,19 @@ use std::collections::HashMap;
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::gpu::{Access, ImageUse};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, ComputePipeline},
-        vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+        BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
     },
+    gpu::{Access, Extent2D, Format, ImageUse},
     planet::{cube::PatchId, detail::PatchHeights, Planet},
     shaders,
 };
 
 /// Format of a patch's base-height texture: one f32 per lattice point, border included.
-pub const HEIGHT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+pub const HEIGHT_FORMAT: Format = Format::R32_SFLOAT;
 
 /// One row of the job table (std430 mirror of `RefineJob` in the shader).
 #[repr(C)]
@@ -157,7 +157,7 @@ impl HeightRefiner {
         let ranges = rec.ctx().create_buffer(&BufferDesc {
             name: "refined height ranges",
             size: (jobs.len() * 8) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            uses: &[Access::ComputeWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })?;
         let mut out = RefinedRanges {
@@ -179,7 +179,7 @@ impl HeightRefiner {
             let mut buffer = rec.ctx().create_buffer(&BufferDesc {
                 name: "height refinement jobs",
                 size: ((end - start) * row) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                uses: &[Access::ComputeRead],
                 location: MemoryLocation::CpuToGpu,
             })?;
             buffer.write(0, &table[start..end])?;
@@ -225,17 +225,18 @@ pub fn create_height_texture(ctx: &Context, vertices: u32, name: &str) -> Result
     let side = PatchHeights::side(vertices) as u32;
     ctx.create_image(&ImageDesc {
         name,
-        extent: vk::Extent2D {
+        extent: Extent2D {
             width: side,
             height: side,
         },
         layers: 1,
         format: HEIGHT_FORMAT,
-        usage: vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::STORAGE
-            | vk::ImageUsageFlags::TRANSFER_DST
-            | vk::ImageUsageFlags::TRANSFER_SRC,
-        aspect: vk::ImageAspectFlags::COLOR,
+        uses: &[
+            Access::GraphicsSampled,
+            Access::ComputeWrite,
+            Access::TransferWrite,
+            Access::TransferRead,
+        ],
         array: true,
     })
 }
@@ -324,7 +325,7 @@ pub fn generate_on_gpu(
     let readback = ctx.create_buffer(&BufferDesc {
         name: "height readback",
         size: texel_bytes * patches.len().max(1) as u64,
-        usage: vk::BufferUsageFlags::TRANSFER_DST,
+        uses: &[Access::TransferWrite, Access::HostRead],
         location: MemoryLocation::GpuToCpu,
     });
     let readback = match readback {

@@ -19,7 +19,7 @@ fn compute_dispatch_reads_back_and_is_timed() {
         .create_buffer(&BufferDesc {
             name: "fill output",
             size,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+            uses: &[Access::ComputeWrite, Access::TransferRead],
             location: MemoryLocation::GpuOnly,
         })
         .unwrap();
@@ -27,7 +27,7 @@ fn compute_dispatch_reads_back_and_is_timed() {
         .create_buffer(&BufferDesc {
             name: "fill readback",
             size,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            uses: &[Access::TransferWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })
         .unwrap();
@@ -84,9 +84,11 @@ fn staging_upload_reaches_device_local_buffer() {
         .create_buffer(&BufferDesc {
             name: "upload target",
             size,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                | vk::BufferUsageFlags::TRANSFER_DST
-                | vk::BufferUsageFlags::TRANSFER_SRC,
+            uses: &[
+                Access::ComputeWrite,
+                Access::TransferWrite,
+                Access::TransferRead,
+            ],
             location: MemoryLocation::GpuOnly,
         })
         .unwrap();
@@ -94,7 +96,7 @@ fn staging_upload_reaches_device_local_buffer() {
         .create_buffer(&BufferDesc {
             name: "upload readback",
             size,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            uses: &[Access::TransferWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })
         .unwrap();
@@ -127,7 +129,7 @@ fn dropped_buffers_and_images_are_freed_once_the_gpu_is_done() {
         .create_buffer(&BufferDesc {
             name: "dropped buffer",
             size: 1 << 20,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            uses: &[Access::TransferWrite],
             location: MemoryLocation::GpuOnly,
         })
         .unwrap();
@@ -140,8 +142,7 @@ fn dropped_buffers_and_images_are_freed_once_the_gpu_is_done() {
             },
             layers: 1,
             format: vk::Format::R32_SFLOAT,
-            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-            aspect: vk::ImageAspectFlags::COLOR,
+            uses: &[Access::GraphicsSampled, Access::TransferWrite],
             array: false,
         })
         .unwrap();

@@ -1,7 +1,7 @@
 //! The one synchronisation vocabulary (after vk-sync's access types, as kajiya uses them): every way a command
 //! uses a resource is an [`Access`], which knows its pipeline stages, its memory access and, for images, its
-//! layout. A barrier names the uses before it and the uses after it; only this module spells stage and access
-//! flags.
+//! layout. A barrier names the uses before it and the uses after it, and a buffer or image is created for the uses
+//! it will have; only this module spells stage, access and usage flags.
 //!
 //! Layouts follow one rule: an image that shaders read or write (storage or sampled usage: the patch textures, the
 //! atmosphere's table) stays in GENERAL from its first use on, written by compute shaders and copies and read by
@@ -32,6 +32,8 @@ pub enum Access {
     VertexShaderWrite,
     /// Read as the parameters of an indirect draw.
     IndirectCommands,
+    /// Read as the index buffer of a draw.
+    IndexRead,
     /// Read by any shader of any stage (what an upload must be visible to when its reader is not known).
     AnyShaderRead,
     /// Written (and blended) as a colour attachment.
@@ -66,6 +68,7 @@ impl Access {
             Access::VertexShaderRead => (S::VERTEX_SHADER, A::SHADER_STORAGE_READ),
             Access::VertexShaderWrite => (S::VERTEX_SHADER, A::SHADER_STORAGE_WRITE),
             Access::IndirectCommands => (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ),
+            Access::IndexRead => (S::INDEX_INPUT, A::INDEX_READ),
             Access::AnyShaderRead => (S::ALL_COMMANDS, A::SHADER_READ | A::SHADER_STORAGE_READ),
             Access::ColorAttachment => (
                 S::COLOR_ATTACHMENT_OUTPUT,
@@ -77,6 +80,37 @@ impl Access {
             ),
             Access::HostRead => (S::HOST, A::HOST_READ),
             Access::Present => (S::BOTTOM_OF_PIPE, A::NONE),
+        }
+    }
+
+    /// The buffer usage flags this use needs (none for the host's).
+    fn buffer_usage(self) -> vk::BufferUsageFlags {
+        use vk::BufferUsageFlags as U;
+        match self {
+            Access::TransferWrite => U::TRANSFER_DST,
+            Access::TransferRead => U::TRANSFER_SRC,
+            Access::ComputeWrite
+            | Access::ComputeRead
+            | Access::VertexShaderRead
+            | Access::VertexShaderWrite
+            | Access::AnyShaderRead => U::STORAGE_BUFFER,
+            Access::IndirectCommands => U::INDIRECT_BUFFER,
+            Access::IndexRead => U::INDEX_BUFFER,
+            _ => U::empty(),
+        }
+    }
+
+    /// The image usage flags this use needs.
+    fn image_usage(self) -> vk::ImageUsageFlags {
+        use vk::ImageUsageFlags as U;
+        match self {
+            Access::TransferWrite => U::TRANSFER_DST,
+            Access::TransferRead => U::TRANSFER_SRC,
+            Access::ComputeWrite | Access::ComputeRead => U::STORAGE,
+            Access::ComputeSampled | Access::GraphicsSampled => U::SAMPLED,
+            Access::ColorAttachment => U::COLOR_ATTACHMENT,
+            Access::DepthAttachment => U::DEPTH_STENCIL_ATTACHMENT,
+            _ => U::empty(),
         }
     }
 
@@ -101,6 +135,18 @@ impl Access {
             (access, false) => access.optimal_layout(),
         }
     }
+}
+
+/// The usage flags a buffer needs for all of `uses`.
+pub(crate) fn buffer_usage(uses: &[Access]) -> vk::BufferUsageFlags {
+    uses.iter()
+        .fold(vk::BufferUsageFlags::empty(), |u, a| u | a.buffer_usage())
+}
+
+/// The usage flags an image needs for all of `uses`.
+pub(crate) fn image_usage(uses: &[Access]) -> vk::ImageUsageFlags {
+    uses.iter()
+        .fold(vk::ImageUsageFlags::empty(), |u, a| u | a.image_usage())
 }
 
 /// The stages and accesses of one side of a barrier. Only writes need to be made available, so the source side

@@ -15,7 +15,7 @@ impl Recorder<'_> {
         let mut staging = self.ctx.create_buffer(&BufferDesc {
             name: &format!("staging for {name}"),
             size: data.len() as u64,
-            usage: vk::BufferUsageFlags::TRANSFER_SRC,
+            uses: &[Access::TransferRead],
             location: MemoryLocation::CpuToGpu,
         })?;
         staging.write(0, data)?;

@@ -9,14 +9,18 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
 pub use gpu_allocator::MemoryLocation;
 
-use super::{Context, GpuError, VkResultExt};
+use super::{
+    access::{self, Access},
+    Context, GpuError, VkResultExt,
+};
 
 /// A buffer request. `name` goes to the debug-utils object name and to the allocation.
 #[derive(Clone, Debug)]
 pub struct BufferDesc<'a> {
     pub name: &'a str,
     pub size: u64,
-    pub usage: vk::BufferUsageFlags,
+    /// Every way the buffer will be used (its usage flags follow: gpu/access.rs).
+    pub uses: &'a [Access],
     pub location: MemoryLocation,
 }
 
@@ -83,8 +87,8 @@ pub struct ImageDesc<'a> {
     pub extent: vk::Extent2D,
     pub layers: u32,
     pub format: vk::Format,
-    pub usage: vk::ImageUsageFlags,
-    pub aspect: vk::ImageAspectFlags,
+    /// Every way the image will be used (its usage flags follow: gpu/access.rs).
+    pub uses: &'a [Access],
     /// View it as a 2D array even with one layer (so shaders can index every patch texture alike).
     pub array: bool,
 }
@@ -117,15 +121,19 @@ impl Image {
 
     /// The subresource range of the whole image.
     pub fn range(&self) -> vk::ImageSubresourceRange {
-        let aspect = if self.format == vk::Format::D32_SFLOAT {
-            vk::ImageAspectFlags::DEPTH
-        } else {
-            vk::ImageAspectFlags::COLOR
-        };
         vk::ImageSubresourceRange::default()
-            .aspect_mask(aspect)
+            .aspect_mask(aspect(self.format))
             .level_count(1)
             .layer_count(self.layers)
+    }
+}
+
+/// The aspect of an image of `format`: depth for the depth format this renderer uses, colour otherwise.
+fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
+    if format == vk::Format::D32_SFLOAT {
+        vk::ImageAspectFlags::DEPTH
+    } else {
+        vk::ImageAspectFlags::COLOR
     }
 }
 
@@ -230,7 +238,7 @@ impl Context {
     pub fn create_buffer(&self, desc: &BufferDesc) -> Result<Buffer, GpuError> {
         let info = vk::BufferCreateInfo::default()
             .size(desc.size.max(4))
-            .usage(desc.usage)
+            .usage(access::buffer_usage(desc.uses))
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid create info; the buffer is destroyed through the deletion queue.
         let raw = unsafe { self.device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
@@ -271,7 +279,7 @@ impl Context {
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(desc.usage)
+            .usage(access::image_usage(desc.uses))
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid create info.
         let raw = unsafe { self.device.create_image(&info, None) }.vk("vkCreateImage")?;
@@ -300,7 +308,7 @@ impl Context {
             .format(desc.format)
             .subresource_range(
                 vk::ImageSubresourceRange::default()
-                    .aspect_mask(desc.aspect)
+                    .aspect_mask(aspect(desc.format))
                     .level_count(1)
                     .layer_count(desc.layers),
             );
@@ -315,7 +323,7 @@ impl Context {
             layers: desc.layers,
             format: desc.format,
             name: desc.name.to_string(),
-            usage: desc.usage,
+            usage: access::image_usage(desc.uses),
             allocation: Some(allocation),
             deletion: self.deletion.clone(),
         })

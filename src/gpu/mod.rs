@@ -27,6 +27,11 @@ pub mod swapchain;
 pub use access::{Access, ImageUse};
 pub use adapter::AdapterInfo;
 pub use ash::vk;
+/// The plain Vulkan value types the layers above describe resources and frames with; they name no flags and call
+/// no Vulkan (synchronisation and usage are said in [`Access`]es).
+pub use ash::vk::{
+    DescriptorSet, DescriptorSetLayout, DrawIndexedIndirectCommand, Extent2D, Format, Semaphore,
+};
 pub use context::{Context, ContextOptions};
 pub use features::FeatureReport;
 pub use memory::{Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};

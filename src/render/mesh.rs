@@ -12,7 +12,7 @@
 
 use std::ops::Range;
 
-use crate::gpu::{vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation};
+use crate::gpu::{Access, Buffer, BufferDesc, Context, GpuError, MemoryLocation};
 
 /// The index ranges of one quadrant, laid out as grid cells, edge skirts, then the two midline skirts.
 #[derive(Clone, Debug, Default)]
@@ -146,7 +146,7 @@ pub fn index_buffer(ctx: &Context, name: &str, indices: &[u32]) -> Result<Buffer
     let buffer = ctx.create_buffer(&BufferDesc {
         name,
         size: std::mem::size_of_val(indices) as u64,
-        usage: vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        uses: &[Access::IndexRead, Access::TransferWrite],
         location: MemoryLocation::GpuOnly,
     })?;
     ctx.run_and_wait(name, |rec| {

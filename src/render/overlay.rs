@@ -13,7 +13,7 @@ use super::{
 };
 use crate::{
     config::LodRule,
-    gpu::{overlay::OverlayRenderer, vk, Context, GpuError, Recorder},
+    gpu::{overlay::OverlayRenderer, Context, Extent2D, Format, GpuError, Recorder},
     kernel::gpu::KernelVariant,
     named::Named,
 };
@@ -44,7 +44,7 @@ impl Overlay {
     pub fn new(
         ctx: &Context,
         window: &Window,
-        (color, depth): (vk::Format, vk::Format),
+        (color, depth): (Format, Format),
         visible: bool,
     ) -> Result<Self, GpuError> {
         let egui = egui::Context::default();
@@ -99,7 +99,7 @@ impl Overlay {
     }
 
     /// Records the prepared overlay into the frame's rendering.
-    pub fn record(&mut self, rec: &mut Recorder, extent: vk::Extent2D) -> Result<(), GpuError> {
+    pub fn record(&mut self, rec: &mut Recorder, extent: Extent2D) -> Result<(), GpuError> {
         if !self.visible {
             return Ok(());
         }

@@ -1,13 +1,12 @@
 //! An offscreen colour + depth target, and reading it back into an image.
 
 use crate::gpu::{
-    pipeline::RenderTarget, vk, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation,
-    Recorder,
+    pipeline::RenderTarget, Access, BufferDesc, Context, Extent2D, Format, GpuError, Image,
+    ImageDesc, ImageUse, MemoryLocation, Recorder,
 };
-use crate::gpu::{Access, ImageUse};
 
-pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
-pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+pub const COLOR_FORMAT: Format = Format::R8G8B8A8_UNORM;
+pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;
 
 /// Colour and depth images of one size.
 pub struct Offscreen {
@@ -26,16 +25,15 @@ impl Offscreen {
         ctx: &Context,
         width: u32,
         height: u32,
-        format: vk::Format,
+        format: Format,
     ) -> Result<Self, GpuError> {
-        let extent = vk::Extent2D { width, height };
+        let extent = Extent2D { width, height };
         let color = ctx.create_image(&ImageDesc {
             name: "offscreen colour",
             extent,
             layers: 1,
             format,
-            usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-            aspect: vk::ImageAspectFlags::COLOR,
+            uses: &[Access::ColorAttachment, Access::TransferRead],
             array: false,
         })?;
         let depth = create_depth(ctx, extent)?;
@@ -59,7 +57,7 @@ impl Offscreen {
         let buffer = ctx.create_buffer(&BufferDesc {
             name: "offscreen readback",
             size: (w * h * 4) as u64,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            uses: &[Access::TransferWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })?;
         let result = ctx.run_and_wait("read offscreen colour", |rec: &mut Recorder| {
@@ -88,7 +86,7 @@ impl Offscreen {
                 .mapped()
                 .ok_or_else(|| GpuError::Invalid("readback not host-visible".into()))?;
             let mut pixels = bytes.to_vec();
-            if self.color.format == vk::Format::B8G8R8A8_UNORM {
+            if self.color.format == Format::B8G8R8A8_UNORM {
                 pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
             }
             image::RgbaImage::from_raw(w, h, pixels)
@@ -99,14 +97,13 @@ impl Offscreen {
 }
 
 /// A depth image for a target of `extent`.
-pub fn create_depth(ctx: &Context, extent: vk::Extent2D) -> Result<Image, GpuError> {
+pub fn create_depth(ctx: &Context, extent: Extent2D) -> Result<Image, GpuError> {
     ctx.create_image(&ImageDesc {
         name: "depth",
         extent,
         layers: 1,
         format: DEPTH_FORMAT,
-        usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        aspect: vk::ImageAspectFlags::DEPTH,
+        uses: &[Access::DepthAttachment],
         array: false,
     })
 }

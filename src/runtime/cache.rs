@@ -65,7 +65,7 @@ impl PatchData {
 }
 
 fn texel_bytes(image: &Image) -> u64 {
-    use crate::gpu::vk::Format;
+    use crate::gpu::Format;
     match image.format {
         Format::R32G32B32A32_SFLOAT => 16,
         _ => 4,

@@ -2,11 +2,11 @@
 //! and the kernel benchmarks.
 
 use super::{create_river_texture, KernelBatch, KernelVariant, RiverKernel, RIVER_TEXTURE_LAYERS};
-use crate::gpu::Access;
 use crate::{
+    gpu::Access,
     gpu::{
         bindless::{Bindless, Slot},
-        vk, Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler, ScopeTiming,
+        Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler, ScopeTiming,
     },
     kernel::{KernelParams, ParentQuadrant, PatchJob, RiverTexel},
 };
@@ -59,7 +59,7 @@ impl BatchOutputs {
         let readback = ctx.create_buffer(&BufferDesc {
             name: "river readback",
             size: Self::texel_bytes(grid_size) * patches.max(1) as u64,
-            usage: vk::BufferUsageFlags::TRANSFER_DST,
+            uses: &[Access::TransferWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })?;
         let mut outputs = Self {

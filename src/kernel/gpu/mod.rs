@@ -7,7 +7,6 @@ mod batch;
 mod jobs;
 mod tuning;
 
-use crate::gpu::{Access, ImageUse};
 use bytemuck::{Pod, Zeroable};
 
 pub use self::{
@@ -20,8 +19,9 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, ComputePipeline},
-        vk, Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+        Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
     },
+    gpu::{Access, Extent2D, Format, ImageUse},
     shaders,
 };
 
@@ -50,7 +50,7 @@ const _: () = assert!(std::mem::size_of::<PushParams>() == 24);
 
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
-pub const RIVER_TEXTURE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const RIVER_TEXTURE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 
 /// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
@@ -164,7 +164,7 @@ impl RiverKernel {
             ctx.create_buffer(&BufferDesc {
                 name,
                 size: size.max(16) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                uses: &[Access::ComputeRead],
                 location: MemoryLocation::CpuToGpu,
             })
         };
@@ -237,7 +237,11 @@ impl RiverKernel {
         let masks = rec.ctx().create_buffer(&BufferDesc {
             name: "river reach masks",
             size: (table.mask_words * 4).max(16),
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            uses: &[
+                Access::TransferWrite,
+                Access::ComputeRead,
+                Access::ComputeWrite,
+            ],
             location: MemoryLocation::GpuOnly,
         })?;
         let size = masks.size;
@@ -286,16 +290,17 @@ impl RiverKernel {
 pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result<Image, GpuError> {
     ctx.create_image(&ImageDesc {
         name,
-        extent: vk::Extent2D {
+        extent: Extent2D {
             width: grid_size,
             height: grid_size,
         },
         layers: RIVER_TEXTURE_LAYERS,
         format: RIVER_TEXTURE_FORMAT,
-        usage: vk::ImageUsageFlags::STORAGE
-            | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC,
-        aspect: vk::ImageAspectFlags::COLOR,
+        uses: &[
+            Access::ComputeWrite,
+            Access::GraphicsSampled,
+            Access::TransferRead,
+        ],
         array: true,
     })
 }

@@ -11,9 +11,9 @@ use super::{
     vertex_cache::VertexCache,
     FrameStats, Renderer,
 };
-use crate::gpu::{Access, ImageUse};
 use crate::{
-    gpu::{pipeline::RenderTarget, vk, Buffer, BufferDesc, GpuError, MemoryLocation, Recorder},
+    gpu::{pipeline::RenderTarget, Buffer, BufferDesc, GpuError, MemoryLocation, Recorder},
+    gpu::{Access, ImageUse},
     planet::cube::{PatchId, EDGES},
     runtime::{camera::Camera, lod::Selected},
 };
@@ -241,7 +241,7 @@ impl Renderer<'_> {
             let mut buffer = ctx.create_buffer(&BufferDesc {
                 name: "patch instances",
                 size: (instances.len().max(1) * std::mem::size_of::<PatchInstance>()) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                uses: &[Access::ComputeRead, Access::VertexShaderRead],
                 location: MemoryLocation::CpuToGpu,
             })?;
             buffer.write(0, &instances)?;
@@ -254,7 +254,11 @@ impl Renderer<'_> {
             let buffer = ctx.create_buffer(&BufferDesc {
                 name: "vertex capture",
                 size,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                uses: &[
+                    Access::TransferWrite,
+                    Access::VertexShaderWrite,
+                    Access::HostRead,
+                ],
                 location: MemoryLocation::GpuToCpu,
             })?;
             rec.fill_buffer(&buffer, 0);

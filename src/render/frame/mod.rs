@@ -31,7 +31,7 @@ use crate::{
         bindless::{Bindless, Slot},
         frames::{FrameRing, FRAMES_IN_FLIGHT},
         pipeline::{Blend, BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
-        vk, Access, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
+        Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, MemoryLocation, Semaphore,
     },
     kernel::{
         gpu::{KernelTuning, KernelVariant, RiverKernel},
@@ -50,7 +50,7 @@ use crate::{
 };
 
 /// Draws recorded into a frame's rendering after its own passes (the viewer's overlay).
-pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, vk::Extent2D);
+pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, Extent2D);
 
 /// The mountain height the fragment shader's colour bands are drawn for (Appendix A's `max-mountain-height`);
 /// other planets scale the bands by their own mountain height.
@@ -145,8 +145,8 @@ impl<'w> Renderer<'w> {
         planet: &'w Planet,
         network: &'w RiverNetwork,
         config: &Config,
-        color_format: vk::Format,
-        depth_format: vk::Format,
+        color_format: Format,
+        depth_format: Format,
     ) -> Result<Self, GpuError> {
         let n = config.rendering.vertices;
         // Resident patches: as many as the memory budget holds at the largest patch (base heights and river data),
@@ -167,7 +167,7 @@ impl<'w> Renderer<'w> {
         let no_capture = ctx.create_buffer(&BufferDesc {
             name: "no vertex capture",
             size: 16,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            uses: &[Access::VertexShaderWrite],
             location: MemoryLocation::GpuOnly,
         })?;
         let layouts = [bindless.layout, instance_layout.layout];
@@ -322,8 +322,8 @@ impl<'w> Renderer<'w> {
         camera: &Camera,
         target: &RenderTarget,
         after: Access,
-        waits: &[(vk::Semaphore, Access)],
-        signals: &[vk::Semaphore],
+        waits: &[(Semaphore, Access)],
+        signals: &[Semaphore],
     ) -> Result<FrameStats, GpuError> {
         self.render_with_overlay(camera, target, after, (waits, signals), None)
     }
@@ -335,7 +335,7 @@ impl<'w> Renderer<'w> {
         camera: &Camera,
         target: &RenderTarget,
         after: Access,
-        (waits, signals): (&[(vk::Semaphore, Access)], &[vk::Semaphore]),
+        (waits, signals): (&[(Semaphore, Access)], &[Semaphore]),
         overlay: Option<Overlay<'_>>,
     ) -> Result<FrameStats, GpuError> {
         let start = Instant::now();

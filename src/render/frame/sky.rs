@@ -2,13 +2,13 @@
 //! bindless texture that every pass reads, and the sky pass that draws the air where no surface is.
 
 use super::{FramePush, Renderer};
-use crate::gpu::{Access, ImageUse};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{Blend, GraphicsDesc, GraphicsPipeline},
-        vk, Buffer, Context, GpuError, Image, ImageDesc, Recorder,
+        Buffer, Context, GpuError, Image, ImageDesc, Recorder,
     },
+    gpu::{Access, DescriptorSet, DescriptorSetLayout, Extent2D, Format, ImageUse},
     planet::atmosphere::Atmosphere,
     render::mesh::{dome_mesh, index_buffer},
     shaders,
@@ -37,20 +37,19 @@ impl Sky {
         ctx: &Context,
         bindless: &mut Bindless,
         atmosphere: &Atmosphere,
-        set_layouts: &[vk::DescriptorSetLayout],
-        formats: (vk::Format, vk::Format),
+        set_layouts: &[DescriptorSetLayout],
+        formats: (Format, Format),
     ) -> Result<Self, GpuError> {
         let table = atmosphere.transmittance_table();
         let image = ctx.create_image(&ImageDesc {
             name: "atmosphere transmittance",
-            extent: vk::Extent2D {
+            extent: Extent2D {
                 width: table.width,
                 height: table.height,
             },
             layers: 1,
-            format: vk::Format::R32G32B32A32_SFLOAT,
-            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-            aspect: vk::ImageAspectFlags::COLOR,
+            format: Format::R32G32B32A32_SFLOAT,
+            uses: &[Access::GraphicsSampled, Access::TransferWrite],
             array: true,
         })?;
         ctx.run_and_wait("upload atmosphere transmittance", |rec| {
@@ -115,7 +114,7 @@ impl Sky {
     }
 
     /// Draws the sky (inside the frame's rendering scope).
-    pub(super) fn record(&self, rec: &mut Recorder, sets: &[vk::DescriptorSet], push: &[u8]) {
+    pub(super) fn record(&self, rec: &mut Recorder, sets: &[DescriptorSet], push: &[u8]) {
         rec.draw_indexed(
             &self.pipeline,
             sets,

@@ -7,9 +7,8 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use super::Renderer;
-use crate::gpu::Access;
 use crate::{
-    gpu::{bindless::Slot, GpuError, Image, Recorder},
+    gpu::{bindless::Slot, Access, GpuError, Image, Recorder},
     kernel::{
         gpu::{create_river_texture, KernelBatch},
         ParentQuadrant, PatchJob, RiverSample,

@@ -13,12 +13,11 @@
 use std::mem::size_of;
 
 use super::FramePush;
-use crate::gpu::Access;
 use crate::{
     gpu::{
-        pipeline::ComputePipeline, vk, Buffer, BufferDesc, Context, GpuError, MemoryLocation,
-        Recorder,
+        pipeline::ComputePipeline, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
     },
+    gpu::{Access, DescriptorSet, DescriptorSetLayout, DrawIndexedIndirectCommand},
     render::mesh::QuadrantMesh,
     shaders,
 };
@@ -38,10 +37,7 @@ pub(super) struct VertexCache {
 }
 
 impl VertexCache {
-    pub(super) fn new(
-        ctx: &Context,
-        layouts: &[vk::DescriptorSetLayout],
-    ) -> Result<Self, GpuError> {
+    pub(super) fn new(ctx: &Context, layouts: &[DescriptorSetLayout]) -> Result<Self, GpuError> {
         let pipeline = ComputePipeline::new(
             ctx,
             shaders::VERTEX_CACHE_COMP,
@@ -63,7 +59,7 @@ impl VertexCache {
         ctx.create_buffer(&BufferDesc {
             name: "vertex cache",
             size: (patches as u64 * n as u64 * n as u64 * VERTEX_BYTES).max(VERTEX_BYTES),
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            uses: &[Access::ComputeWrite, Access::VertexShaderRead],
             location: MemoryLocation::GpuOnly,
         })
     }
@@ -85,8 +81,12 @@ impl VertexCache {
             .collect();
         let mut buffer = ctx.create_buffer(&BufferDesc {
             name: "water draws",
-            size: (draws.len().max(1) * size_of::<vk::DrawIndexedIndirectCommand>()) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::INDIRECT_BUFFER,
+            size: (draws.len().max(1) * size_of::<DrawIndexedIndirectCommand>()) as u64,
+            uses: &[
+                Access::ComputeRead,
+                Access::ComputeWrite,
+                Access::IndirectCommands,
+            ],
             location: MemoryLocation::CpuToGpu,
         })?;
         buffer.write(0, &draws)?;
@@ -98,7 +98,7 @@ impl VertexCache {
     pub(super) fn record(
         &self,
         rec: &mut Recorder,
-        (sets, push): (&[vk::DescriptorSet], &[u8]),
+        (sets, push): (&[DescriptorSet], &[u8]),
         (cache, water_draws): (&Buffer, &Buffer),
         patches: usize,
         n: u32,
