@@ -66,18 +66,7 @@ impl Recorder<'_> {
     ) -> Result<(), GpuError> {
         let layout = Access::TransferWrite.layout(dst.shader_visible());
         let src = self.stage(&dst.name, data)?;
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .base_array_layer(layer)
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: dst.extent.width,
-                height: dst.extent.height,
-                depth: 1,
-            });
+        let region = whole_layers(dst, layer, 1, 0);
         // SAFETY: the image is in `layout` (caller's contract: the barrier before) and alive until completion.
         unsafe {
             self.ctx
@@ -91,18 +80,7 @@ impl Recorder<'_> {
     /// layer, tightly packed.
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
         let layout = Access::TransferRead.layout(src.shader_visible());
-        let region = vk::BufferImageCopy::default()
-            .buffer_offset(offset)
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(src.layers),
-            )
-            .image_extent(vk::Extent3D {
-                width: src.extent.width,
-                height: src.extent.height,
-                depth: 1,
-            });
+        let region = whole_layers(src, 0, src.layers, offset);
         // SAFETY: the layout is the caller's contract (the barrier before); both objects outlive the submission.
         unsafe {
             self.ctx
@@ -136,18 +114,14 @@ impl Recorder<'_> {
     /// A barrier between the uses `before` and `after` of `buffer` (gpu/access.rs).
     pub fn buffer_barrier(&mut self, buffer: &Buffer, before: &[Access], after: &[Access]) {
         let barrier = [access::buffer_barrier(buffer.raw, before, after)];
-        let dep = vk::DependencyInfo::default().buffer_memory_barriers(&barrier);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+        self.pipeline_barrier(&vk::DependencyInfo::default().buffer_memory_barriers(&barrier));
     }
 
     /// A barrier between the uses `before` and `after` of every resource (cheaper to write than one per resource
     /// when many patches are involved).
     pub fn memory_barrier(&mut self, before: &[Access], after: &[Access]) {
         let barrier = [access::memory_barrier(before, after)];
-        let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+        self.pipeline_barrier(&vk::DependencyInfo::default().memory_barriers(&barrier));
     }
 
     /// Barriers of every subresource of each of `images` for `usage`.
@@ -158,12 +132,9 @@ impl Recorder<'_> {
                 access::image_barrier(image.raw, image.range(), image.shader_visible(), &usage)
             })
             .collect();
-        if barriers.is_empty() {
-            return;
+        if !barriers.is_empty() {
+            self.pipeline_barrier(&vk::DependencyInfo::default().image_memory_barriers(&barriers));
         }
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
     }
 
     /// A barrier of an attachment that is not one of our [`Image`]s (a swapchain image, or a render target's
@@ -178,9 +149,12 @@ impl Recorder<'_> {
             .level_count(1)
             .layer_count(1);
         let barrier = [access::image_barrier(image, range, false, &usage)];
-        let dep = vk::DependencyInfo::default().image_memory_barriers(&barrier);
-        // SAFETY: recording.
-        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+        self.pipeline_barrier(&vk::DependencyInfo::default().image_memory_barriers(&barrier));
+    }
+
+    fn pipeline_barrier(&mut self, dependency: &vk::DependencyInfo) {
+        // SAFETY: recording; the barriers name live resources.
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, dependency) };
     }
 
     /// Binds `pipeline` with `sets` (from set 0) and `push` constants, and dispatches `groups` workgroups.
@@ -376,4 +350,21 @@ impl Recorder<'_> {
                 .cmd_bind_index_buffer(self.cmd, indices.raw, 0, vk::IndexType::UINT32)
         };
     }
+}
+
+/// A copy between layers `first..first + count` of `image` (whole, colour) and tightly packed texels at `offset`.
+fn whole_layers(image: &Image, first: u32, count: u32, offset: u64) -> vk::BufferImageCopy {
+    vk::BufferImageCopy::default()
+        .buffer_offset(offset)
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .base_array_layer(first)
+                .layer_count(count),
+        )
+        .image_extent(vk::Extent3D {
+            width: image.extent.width,
+            height: image.extent.height,
+            depth: 1,
+        })
 }
