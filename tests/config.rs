@@ -314,3 +314,50 @@ fn a_continents_image_named_in_a_file_is_found_beside_the_file() {
         "/data/earth.png"
     );
 }
+
+/// docs/configuration.md documents exactly the elements the reader's tables know: every element has a row (the
+/// Table 6.1 table names the element, the added table its section and element), and every row names an element
+/// of that section.
+#[test]
+fn the_documentation_lists_exactly_the_elements_read() {
+    let docs = include_str!("../docs/configuration.md");
+    let rows: Vec<Vec<&str>> = docs
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("|---"))
+        .map(|l| {
+            l.split('|')
+                .map(str::trim)
+                .filter(|c| !c.is_empty())
+                .collect()
+        })
+        .collect();
+    let elements = riverplanet::config::elements();
+    let section_of = |s: &str| format!("{s}-attributes");
+    let documented = |(section, element): &(&str, &str)| {
+        rows.iter().any(|r| {
+            r.first() == Some(element)
+                || (r.len() > 1 && r[1] == *element && section_of(r[0]) == *section)
+        })
+    };
+    let missing: Vec<_> = elements.iter().filter(|e| !documented(e)).collect();
+    assert!(
+        missing.is_empty(),
+        "elements read but not documented: {missing:?}"
+    );
+    let known = |name: &str| elements.iter().any(|(_, e)| *e == name);
+    let sections = ["planet", "river", "rendering"];
+    let unknown: Vec<_> = rows
+        .iter()
+        .filter(|r| r.first() != Some(&"element") && r.first() != Some(&"section"))
+        .filter(|r| {
+            if sections.contains(&r[0]) {
+                !elements
+                    .iter()
+                    .any(|(s, e)| *s == section_of(r[0]) && *e == r[1])
+            } else {
+                !known(r[0])
+            }
+        })
+        .collect();
+    assert!(unknown.is_empty(), "documented but not read: {unknown:?}");
+}

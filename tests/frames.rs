@@ -29,6 +29,7 @@ fn a_flight_keeps_two_frames_in_flight_and_passes_synchronization_validation() {
     let frames = 100;
     let flight = Flight::new(world, frames, 1.0, w as f64 / h as f64);
     let mut timed = Vec::new();
+    let mut returned_early = 0;
     for frame in 0..frames {
         let stats = common::render_frame(&mut renderer, &flight.camera(world, frame), &target);
         // The CPU never waited for the previous frame before submitting this one, and returned before the GPU
@@ -39,13 +40,19 @@ fn a_flight_keeps_two_frames_in_flight_and_passes_synchronization_validation() {
             stats.frame,
             stats.synchronized_frame
         );
-        assert!(stats.frames_in_flight >= 1, "frame {}", stats.frame);
+        // Whether the GPU was still busy with it when the call returned depends on how fast the GPU was; the
+        // CPU's not waiting (above) does not.
+        returned_early += usize::from(stats.frames_in_flight >= 1);
         timed.extend(renderer.take_gpu_times().into_iter().map(|t| t.frame));
     }
     renderer.finish().unwrap();
     timed.extend(renderer.take_gpu_times().into_iter().map(|t| t.frame));
     // Every frame's GPU times arrive exactly once, in order.
     assert_eq!(timed, (1..=frames as u64).collect::<Vec<_>>());
+    assert!(
+        returned_early >= frames as usize / 4,
+        "only {returned_early} of {frames} frames were still on the GPU when render returned"
+    );
     renderer.destroy();
     drop(target);
     eprintln!(

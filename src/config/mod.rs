@@ -1,0 +1,277 @@
+//! The XML configuration of Table 6.1 and Appendix A, validated into typed values (read.rs reads the file through
+//! one table per section).
+//!
+//! The thesis's Appendix A file is accepted exactly as printed: C-style float suffixes (`1024.0f`) and the stray
+//! `>` in `<continents-from-file>>false</continents-from-file>`. Every other deviation is an error that names the
+//! element, the value and the valid range. Parameters beyond Table 6.1 (needed by the implementation) have
+//! defaults and are documented in `docs/configuration.md`.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+mod read;
+pub use read::elements;
+
+/// A configuration problem: which file, which element, what was wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("cannot read configuration file {path}: {source}")]
+    Read {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: malformed configuration XML: {message}")]
+    Xml { path: String, message: String },
+    #[error("{path}: unknown element {detail}")]
+    UnknownElement { path: String, detail: String },
+    #[error("{path}: <{element}> = '{value}' is invalid: {expected}")]
+    Value {
+        path: String,
+        element: String,
+        value: String,
+        expected: String,
+    },
+}
+
+/// The deepest `max-level-of-detail` accepted (33 vertices per patch edge allow 25: see MAX_LATTICE_CELLS).
+pub const MAX_LEVEL_OF_DETAIL: u32 = 26;
+/// Lattice cells per face edge at the deepest level, at most.
+pub const MAX_LATTICE_CELLS: u32 = 1 << 30;
+
+/// `<planet-attributes>`: Table 6.1 plus the base-terrain parameters of Chapter 4.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanetConfig {
+    pub radius: f32,
+    pub continents: u32,
+    pub landmass_percentage: f32,
+    pub sea_level_height: f32,
+    pub max_mountain_height: f32,
+    pub atmosphere_height: f32,
+    /// `-1` in the file: pick a seed at start (logged). Resolved by [`Config::resolve_seed`].
+    pub master_seed: i64,
+    pub continents_from_file: bool,
+    /// Image read when `continents_from_file` is true (equirectangular, land bright / sea dark); in a file,
+    /// relative to the file's folder (the default, config/continents.png, to the working folder).
+    pub continents_image: String,
+    /// Mountains (3x3 masks) seeded per continent (4.2).
+    pub mountains_per_continent: u32,
+    /// Height of the eight cells around a mountain top, as a fraction of `max-mountain-height` (4.2).
+    pub mountain_shoulder_factor: f32,
+    /// Height of continental cells before diamond-square detail.
+    pub continent_height: f32,
+    /// Height of ocean cells before diamond-square detail.
+    pub ocean_height: f32,
+    /// Maximum step of the coast perturbation filter, in cells of the coarsest heightmap (4.1).
+    pub coast_perturbation: f32,
+    /// Diamond-square displacement at level 0, in height units; halves each level (3.6).
+    pub detail_amplitude: f32,
+    /// Cells per face edge of the coarsest heightmap on which continents are built: 2^n+1.
+    pub base_resolution: u32,
+}
+
+/// Where rivers come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RiverModel {
+    /// Chapter 5: one river per mountain, a random walk to the nearest sea, over the thesis's relief.
+    Thesis,
+    /// Beyond the thesis (docs/rivers.md): relief with ranges and valleys, water routed over the whole sphere,
+    /// rivers as trees that join at confluences and end in the sea or in lakes.
+    Drainage,
+}
+
+/// `<river-attributes>`: Table 6.1 plus the river-generation parameters of Chapter 5.
+#[derive(Clone, Debug, Serialize)]
+pub struct RiverConfig {
+    pub model: RiverModel,
+    /// Drainage model: the drainage area (world units squared) at which a river begins.
+    pub source_area: f32,
+    /// Drainage model: how deep a depression must be (height units) to be kept as a lake.
+    pub lake_depth: f32,
+    pub influence_distance: f32,
+    pub basin_depth: f32,
+    pub basin_water_offset: f32,
+    pub starting_width: f32,
+    pub min_width: f32,
+    pub ending_factor: f32,
+    pub segments: u32,
+    /// Subdivision levels included in each river's convex hull (5.2.3: the thesis uses 3).
+    pub hull_levels: u32,
+    /// Probability that a segment spawns a tributary when subdivided (5.2.3).
+    pub tributary_probability: f32,
+    /// Largest random displacement of a knot when a segment is subdivided, as a fraction of segment length / pieces
+    /// (5.2.2).
+    pub displacement: f32,
+    /// Directions tried per mountain before it is given up as a river source (5.2.1).
+    pub max_attempts: u32,
+    /// Samples per half river width (6.4: "three sample points for every distance half the width").
+    pub samples_per_half_width: u32,
+    /// Beyond the thesis: samples at most this many per vertex spacing along a river (0: no limit, the thesis's
+    /// rule). On a planet whose rivers are many orders of magnitude narrower than a coarse patch, the thesis's
+    /// rule gives a coarse patch millions of samples for detail its vertices cannot show.
+    pub samples_per_vertex_spacing: u32,
+}
+
+/// How the level of detail picks a patch's level (6.2.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LodRule {
+    /// Beyond the thesis: refine while a patch's geometric error would cover more than `pixel-error` pixels.
+    ScreenSpaceError,
+    /// The thesis's Eq. 6.1 (the default): refine while nearer than radius x switch factor / 2^level.
+    Distance,
+}
+
+/// `<rendering-attributes>`: Table 6.1 plus the run-time budgets.
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderingConfig {
+    pub vertices: u32,
+    pub max_level_of_detail: u32,
+    pub level_of_detail_switch_factor: f32,
+    pub level_of_detail_rule: LodRule,
+    /// Screen-space-error rule: the geometric error, in pixels, a patch may show before it is refined.
+    pub pixel_error: f32,
+    /// Patch textures resident at once (bindless slots); least recently used are evicted beyond it.
+    pub max_resident_patches: u32,
+    /// New patches generated per frame at most; the rest draw their parent until their data arrives.
+    pub new_patches_per_frame: u32,
+    /// GPU time per frame for making new patches (base heights and river data), in milliseconds: fewer patches
+    /// are made when the measured time per patch says the count would exceed it.
+    pub generation_budget_ms: f32,
+    /// Memory of resident patch textures at most, in MB (with max-resident-patches, whichever is smaller).
+    pub resident_memory_mb: u32,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Config {
+    pub planet: PlanetConfig,
+    pub river: RiverConfig,
+    pub rendering: RenderingConfig,
+}
+
+impl Config {
+    /// The defaults of a file with `model`: Appendix A's values (`appendix_a`), and for the drainage model the
+    /// values config/planet.xml was tuned with (docs/rivers.md): a river where 700
+    /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), and at most four
+    /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples).
+    pub fn defaults_for(model: RiverModel) -> Self {
+        let mut d = Self::appendix_a();
+        d.river.model = model;
+        if model == RiverModel::Drainage {
+            d.planet.detail_amplitude = 2.0;
+            d.river.source_area = 700.0;
+            d.river.samples_per_vertex_spacing = 4;
+        }
+        d
+    }
+
+    /// The values of Appendix A with the thesis's river model, and `master-seed` 1 instead of -1 so the planet is
+    /// reproducible: the planet of the thesis's Chapter 9 experiments.
+    pub fn appendix_a() -> Self {
+        Self {
+            planet: PlanetConfig {
+                radius: 1024.0,
+                continents: 5,
+                landmass_percentage: 30.0,
+                sea_level_height: 0.4,
+                max_mountain_height: 16.0,
+                atmosphere_height: 32.0,
+                master_seed: 1,
+                continents_from_file: false,
+                continents_image: "config/continents.png".into(),
+                mountains_per_continent: 4,
+                mountain_shoulder_factor: 0.5,
+                continent_height: 2.0,
+                ocean_height: -4.0,
+                coast_perturbation: 3.0,
+                detail_amplitude: 8.0,
+                base_resolution: 129,
+            },
+            river: RiverConfig {
+                model: RiverModel::Thesis,
+                source_area: 20000.0,
+                lake_depth: 0.5,
+                influence_distance: 20.0,
+                basin_depth: 0.1,
+                basin_water_offset: 0.001,
+                starting_width: 2.5,
+                min_width: 0.075,
+                ending_factor: 2.0,
+                segments: 5,
+                hull_levels: 3,
+                tributary_probability: 0.5,
+                displacement: 0.3,
+                max_attempts: 16,
+                samples_per_half_width: 3,
+                samples_per_vertex_spacing: 0,
+            },
+            rendering: RenderingConfig {
+                vertices: 33,
+                max_level_of_detail: 6,
+                level_of_detail_switch_factor: 8.0,
+                level_of_detail_rule: LodRule::Distance,
+                pixel_error: 2.0,
+                max_resident_patches: 2048,
+                new_patches_per_frame: 64,
+                generation_budget_ms: 8.0,
+                resident_memory_mb: 256,
+            },
+        }
+    }
+}
+
+impl Default for Config {
+    /// The product's default: Appendix A's planet with the drainage model (docs/rivers.md), the planet of
+    /// config/planet.xml. The thesis's model is `Config::appendix_a()` and config/thesis.xml.
+    fn default() -> Self {
+        Self::defaults_for(RiverModel::Drainage)
+    }
+}
+
+impl Config {
+    /// Reads and validates a configuration file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// The quadtree level whose whole-face lattice the base heightmap is: its cells per face edge are a patch's
+    /// (`vertices - 1`) times 2^level, for a level down to `max-level-of-detail`; `None` if there is none.
+    pub fn base_level(&self) -> Option<u32> {
+        let cells = self.planet.base_resolution - 1;
+        (0..=self.rendering.max_level_of_detail)
+            .find(|l| (self.rendering.vertices - 1) << l == cells)
+    }
+
+    /// What `base-resolution` must be, with the valid values (up to level 6) for these vertices.
+    pub fn base_resolution_rule(&self) -> String {
+        let (n, max) = (self.rendering.vertices, self.rendering.max_level_of_detail);
+        let valid: Vec<String> = (0..=max.min(6))
+            .map(|l| (((n - 1) << l) + 1).to_string())
+            .collect();
+        format!(
+            "must be (vertices - 1) x 2^b + 1 for some b <= max-level-of-detail {max} (with vertices {n}: {})",
+            valid.join(", ")
+        )
+    }
+
+    /// The seed to use: the configured one, or for `-1` a fresh one from the clock (logged so a run can be
+    /// repeated).
+    pub fn resolve_seed(&self) -> u32 {
+        if self.planet.master_seed >= 0 {
+            return self.planet.master_seed as u32;
+        }
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(0);
+        let seed = (nanos ^ (nanos >> 32)) as u32;
+        log::info!("master-seed -1: picked seed {seed}");
+        seed
+    }
+}

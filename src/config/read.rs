@@ -1,0 +1,531 @@
+//! Reading the XML file into a [`Config`]: one declarative table per section names every element once, with what
+//! it accepts and the field it sets; the typed values and their defaults are config/mod.rs's. An element that is
+//! absent keeps its default (Appendix A's, or the drainage model's: `river-model` is read first). docs/configuration.md
+//! documents every element of the tables (tests/config.rs checks both ways).
+
+use std::fmt;
+
+use xml::reader::{EventReader, XmlEvent};
+
+use super::{
+    Config, ConfigError, LodRule, PlanetConfig, RenderingConfig, RiverConfig, RiverModel,
+    MAX_LATTICE_CELLS, MAX_LEVEL_OF_DETAIL,
+};
+
+/// A closed or open numeric range for messages and checks.
+#[derive(Clone, Copy, Debug)]
+enum Range {
+    Positive,
+    NonNegative,
+    Open(f64, f64),
+    Closed(f64, f64),
+    Any,
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Range::Positive => write!(f, "must be a number > 0"),
+            Range::NonNegative => write!(f, "must be a number >= 0"),
+            Range::Open(a, b) => write!(f, "must be a number in ({a}, {b}) (exclusive)"),
+            Range::Closed(a, b) => write!(f, "must be a number in [{a}, {b}]"),
+            Range::Any => write!(f, "must be a number"),
+        }
+    }
+}
+
+impl Range {
+    fn contains(self, x: f64) -> bool {
+        x.is_finite()
+            && match self {
+                Range::Positive => x > 0.0,
+                Range::NonNegative => x >= 0.0,
+                Range::Open(a, b) => x > a && x < b,
+                Range::Closed(a, b) => x >= a && x <= b,
+                Range::Any => true,
+            }
+    }
+}
+
+/// One element of a section of type `S`: its name, what it accepts, and the field it sets.
+enum Param<S> {
+    /// A number in a range, held in single precision.
+    Number(&'static str, Range, fn(&mut S) -> &mut f32),
+    /// A whole number in [min, max].
+    Whole(&'static str, u32, u32, fn(&mut S) -> &mut u32),
+    /// A whole number of the form 2^n + 1 in [min, max].
+    Grid(&'static str, u32, u32, fn(&mut S) -> &mut u32),
+    Flag(&'static str, fn(&mut S) -> &mut bool),
+    /// One of the names; the setter takes the index of the one given.
+    Choice(&'static str, &'static [&'static str], fn(&mut S, usize)),
+    /// A path, relative to the file's folder.
+    Path(&'static str, fn(&mut S) -> &mut String),
+    /// -1 (pick one at start) or a 32-bit seed.
+    Seed(&'static str, fn(&mut S) -> &mut i64),
+}
+
+impl<S> Param<S> {
+    fn name(&self) -> &'static str {
+        match self {
+            Param::Number(n, ..)
+            | Param::Whole(n, ..)
+            | Param::Grid(n, ..)
+            | Param::Flag(n, ..)
+            | Param::Choice(n, ..)
+            | Param::Path(n, ..)
+            | Param::Seed(n, ..) => n,
+        }
+    }
+}
+
+const RIVER_MODELS: [(&str, RiverModel); 2] = [
+    ("thesis", RiverModel::Thesis),
+    ("drainage", RiverModel::Drainage),
+];
+const LOD_RULES: [(&str, LodRule); 2] = [
+    ("screen-space-error", LodRule::ScreenSpaceError),
+    ("distance", LodRule::Distance),
+];
+const RIVER_MODEL_NAMES: [&str; 2] = [RIVER_MODELS[0].0, RIVER_MODELS[1].0];
+const LOD_RULE_NAMES: [&str; 2] = [LOD_RULES[0].0, LOD_RULES[1].0];
+
+/// `<planet-attributes>`.
+const PLANET: &[Param<PlanetConfig>] = &[
+    Param::Number("radius", Range::Positive, |c| &mut c.radius),
+    Param::Whole("continents", 1, 64, |c| &mut c.continents),
+    Param::Number("landmass-percentage", Range::Open(0.0, 100.0), |c| {
+        &mut c.landmass_percentage
+    }),
+    Param::Number("sea-level-height", Range::Any, |c| &mut c.sea_level_height),
+    Param::Number("max-mountain-height", Range::Positive, |c| {
+        &mut c.max_mountain_height
+    }),
+    Param::Number("atmosphere-height", Range::NonNegative, |c| {
+        &mut c.atmosphere_height
+    }),
+    Param::Seed("master-seed", |c| &mut c.master_seed),
+    Param::Flag("continents-from-file", |c| &mut c.continents_from_file),
+    Param::Path("continents-image", |c| &mut c.continents_image),
+    Param::Whole("mountains-per-continent", 0, 1000, |c| {
+        &mut c.mountains_per_continent
+    }),
+    Param::Number("mountain-shoulder-factor", Range::Closed(0.0, 1.0), |c| {
+        &mut c.mountain_shoulder_factor
+    }),
+    Param::Number("continent-height", Range::Any, |c| &mut c.continent_height),
+    Param::Number("ocean-height", Range::Any, |c| &mut c.ocean_height),
+    Param::Number("coast-perturbation", Range::Closed(0.0, 64.0), |c| {
+        &mut c.coast_perturbation
+    }),
+    Param::Number("detail-amplitude", Range::NonNegative, |c| {
+        &mut c.detail_amplitude
+    }),
+    Param::Grid("base-resolution", 9, 1025, |c| &mut c.base_resolution),
+];
+
+/// `<river-attributes>`.
+const RIVER: &[Param<RiverConfig>] = &[
+    Param::Choice("river-model", &RIVER_MODEL_NAMES, |c, i| {
+        c.model = RIVER_MODELS[i].1
+    }),
+    Param::Number("source-area", Range::Positive, |c| &mut c.source_area),
+    Param::Number("lake-depth", Range::Positive, |c| &mut c.lake_depth),
+    Param::Number("influence-distance", Range::Positive, |c| {
+        &mut c.influence_distance
+    }),
+    Param::Number("basin-depth", Range::NonNegative, |c| &mut c.basin_depth),
+    Param::Number("basin-water-offset", Range::NonNegative, |c| {
+        &mut c.basin_water_offset
+    }),
+    Param::Number("starting-width", Range::Positive, |c| &mut c.starting_width),
+    Param::Number("min-width", Range::Positive, |c| &mut c.min_width),
+    Param::Number("ending-factor", Range::Positive, |c| &mut c.ending_factor),
+    Param::Whole("segments", 1, 64, |c| &mut c.segments),
+    Param::Whole("hull-levels", 0, 8, |c| &mut c.hull_levels),
+    Param::Number("tributary-probability", Range::Closed(0.0, 1.0), |c| {
+        &mut c.tributary_probability
+    }),
+    Param::Number("displacement", Range::Closed(0.0, 1.0), |c| {
+        &mut c.displacement
+    }),
+    Param::Whole("max-attempts", 1, 1000, |c| &mut c.max_attempts),
+    Param::Whole("samples-per-half-width", 1, 16, |c| {
+        &mut c.samples_per_half_width
+    }),
+    Param::Whole("samples-per-vertex-spacing", 0, 64, |c| {
+        &mut c.samples_per_vertex_spacing
+    }),
+];
+
+/// `<rendering-attributes>`.
+const RENDERING: &[Param<RenderingConfig>] = &[
+    Param::Grid("vertices", 3, 129, |c| &mut c.vertices),
+    Param::Whole("max-level-of-detail", 0, MAX_LEVEL_OF_DETAIL, |c| {
+        &mut c.max_level_of_detail
+    }),
+    Param::Number("level-of-detail-switch-factor", Range::Positive, |c| {
+        &mut c.level_of_detail_switch_factor
+    }),
+    Param::Choice("level-of-detail-rule", &LOD_RULE_NAMES, |c, i| {
+        c.level_of_detail_rule = LOD_RULES[i].1
+    }),
+    Param::Number("pixel-error", Range::Positive, |c| &mut c.pixel_error),
+    Param::Whole("max-resident-patches", 16, 1 << 20, |c| {
+        &mut c.max_resident_patches
+    }),
+    Param::Whole("new-patches-per-frame", 1, 1 << 16, |c| {
+        &mut c.new_patches_per_frame
+    }),
+    Param::Number("generation-budget-ms", Range::Positive, |c| {
+        &mut c.generation_budget_ms
+    }),
+    Param::Whole("resident-memory-mb", 16, 1 << 20, |c| {
+        &mut c.resident_memory_mb
+    }),
+];
+
+/// The sections under the root, in the order they are read.
+const SECTIONS: [&str; 3] = [
+    "planet-attributes",
+    "river-attributes",
+    "rendering-attributes",
+];
+
+/// Every element of every section, as (section, element): what docs/configuration.md must document.
+pub fn elements() -> Vec<(&'static str, &'static str)> {
+    let names = |params: Vec<&'static str>, section| params.into_iter().map(move |n| (section, n));
+    names(PLANET.iter().map(Param::name).collect(), SECTIONS[0])
+        .chain(names(RIVER.iter().map(Param::name).collect(), SECTIONS[1]))
+        .chain(names(
+            RENDERING.iter().map(Param::name).collect(),
+            SECTIONS[2],
+        ))
+        .collect()
+}
+
+/// Strips what the thesis's C++ file format tolerated: surrounding space, a C float suffix, a stray leading `>`.
+fn clean(text: &str) -> &str {
+    let t = text.trim().trim_start_matches('>').trim();
+    t.strip_suffix(['f', 'F'])
+        .filter(|s| s.parse::<f64>().is_ok())
+        .unwrap_or(t)
+}
+
+/// The text of the elements of one section, in file order.
+type Section = Vec<(String, String)>;
+
+/// The file's sections by name (each at most once), after checking the shape: one `<planet>` root whose children
+/// are sections, whose children are elements that hold text only.
+fn sections(text: &str, path: &str) -> Result<Vec<(String, Section)>, ConfigError> {
+    let error = |message: String| ConfigError::Xml {
+        path: path.to_string(),
+        message,
+    };
+    let mut out: Vec<(String, Section)> = Vec::new();
+    // The open elements, outermost first.
+    let mut open: Vec<String> = Vec::new();
+    let mut roots = 0usize;
+    for event in EventReader::new(text.as_bytes()) {
+        match event.map_err(|e| error(e.to_string()))? {
+            XmlEvent::StartElement {
+                name, attributes, ..
+            } => {
+                let name = name.local_name;
+                match open.len() {
+                    0 => {
+                        roots += 1;
+                        if name != "planet" {
+                            return Err(error(format!(
+                                "the root element is <{name}>; it must be <planet>"
+                            )));
+                        }
+                        if roots > 1 {
+                            return Err(error(
+                                "a second <planet> after the first one's end".into(),
+                            ));
+                        }
+                    }
+                    1 => {
+                        if !SECTIONS.contains(&name.as_str()) {
+                            return Err(ConfigError::UnknownElement {
+                                path: path.to_string(),
+                                detail: format!(
+                                    "`{name}` in <planet>, expected one of `{}`",
+                                    SECTIONS.join("`, `")
+                                ),
+                            });
+                        }
+                        if out.iter().any(|(s, _)| *s == name) {
+                            return Err(error(format!("<{name}> appears twice")));
+                        }
+                        out.push((name.clone(), Vec::new()));
+                    }
+                    2 => {
+                        let section = &mut out.last_mut().expect("a section is open").1;
+                        if section.iter().any(|(e, _)| *e == name) {
+                            return Err(error(format!("<{name}> appears twice in <{}>", open[1])));
+                        }
+                        section.push((name.clone(), String::new()));
+                    }
+                    _ => {
+                        return Err(error(format!(
+                            "<{name}> inside <{}>: an element holds a value, not elements",
+                            open[open.len() - 1]
+                        )))
+                    }
+                }
+                if let Some(attribute) = attributes.first() {
+                    return Err(error(format!(
+                        "<{name}> has the attribute {}; elements take none",
+                        attribute.name.local_name
+                    )));
+                }
+                open.push(name);
+            }
+            XmlEvent::EndElement { .. } => {
+                open.pop();
+            }
+            XmlEvent::Characters(t) | XmlEvent::CData(t) | XmlEvent::Whitespace(t) => {
+                if open.len() == 3 {
+                    if let Some((_, value)) = out.last_mut().and_then(|(_, s)| s.last_mut()) {
+                        value.push_str(&t);
+                    }
+                } else if !t.trim().is_empty() {
+                    let place = open
+                        .last()
+                        .map_or("the file".to_string(), |o| format!("<{o}>"));
+                    return Err(error(format!("text '{}' directly in {place}", t.trim())));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(out)
+}
+
+/// Reads the elements of one section into `target` through `table`; an element the table does not name is an
+/// error that lists those it does. `folder`: the file's folder, for paths.
+fn read_section<S>(
+    (name, elements): (&str, &Section),
+    table: &[Param<S>],
+    target: &mut S,
+    (path, folder): (&str, &std::path::Path),
+) -> Result<(), ConfigError> {
+    let error = |element: &str, value: &str, expected: String| ConfigError::Value {
+        path: path.to_string(),
+        element: element.to_string(),
+        value: value.to_string(),
+        expected,
+    };
+    for (element, text) in elements {
+        // Table 6.1 prints "mas-level-of-detail"; Appendix A "max-level-of-detail". Both are accepted.
+        let wanted = if element == "mas-level-of-detail" {
+            "max-level-of-detail"
+        } else {
+            element.as_str()
+        };
+        let Some(param) = table.iter().find(|p| p.name() == wanted) else {
+            let names: Vec<&str> = table.iter().map(Param::name).collect();
+            return Err(ConfigError::UnknownElement {
+                path: path.to_string(),
+                detail: format!(
+                    "`{element}` in <{name}>, expected one of `{}`",
+                    names.join("`, `")
+                ),
+            });
+        };
+        let value = clean(text);
+        match param {
+            Param::Number(_, range, field) => match value.parse::<f64>() {
+                // The value must hold as an f32 too: 1e39 would become infinity and 1e-50 zero.
+                Ok(x) if range.contains(x) && range.contains(x as f32 as f64) => {
+                    *field(target) = x as f32
+                }
+                Ok(x) if range.contains(x) => {
+                    return Err(error(
+                        wanted,
+                        text,
+                        format!(
+                            "{range}, within single precision (about 1.2e-38 to 3.4e38 in size)"
+                        ),
+                    ))
+                }
+                _ => return Err(error(wanted, text, range.to_string())),
+            },
+            Param::Whole(_, min, max, field) => match value.parse::<u32>() {
+                Ok(x) if (*min..=*max).contains(&x) => *field(target) = x,
+                _ => {
+                    return Err(error(
+                        wanted,
+                        text,
+                        format!("must be a whole number in [{min}, {max}]"),
+                    ))
+                }
+            },
+            Param::Grid(_, min, max, field) => match value.parse::<u32>() {
+                Ok(x) if (*min..=*max).contains(&x) && (x - 1).is_power_of_two() => {
+                    *field(target) = x
+                }
+                _ => {
+                    return Err(error(
+                        wanted,
+                        text,
+                        format!("must be of the form 2^n+1 in [{min}, {max}] (e.g. 17, 33, 65)"),
+                    ))
+                }
+            },
+            Param::Flag(_, field) => match value.to_ascii_lowercase().as_str() {
+                "true" | "1" | "yes" => *field(target) = true,
+                "false" | "0" | "no" => *field(target) = false,
+                _ => return Err(error(wanted, text, "must be true or false".into())),
+            },
+            Param::Choice(_, names, set) => {
+                let lower = value.to_ascii_lowercase();
+                match names.iter().position(|n| *n == lower) {
+                    Some(i) => set(target, i),
+                    None => {
+                        return Err(error(
+                            wanted,
+                            text,
+                            format!("must be one of {}", names.join(", ")),
+                        ))
+                    }
+                }
+            }
+            // A path written in the file is relative to the file's folder, so the file works from any folder.
+            Param::Path(_, field) => {
+                *field(target) = folder.join(text.trim()).to_string_lossy().into_owned()
+            }
+            Param::Seed(_, field) => match value.parse::<i64>() {
+                Ok(s) if (-1..=u32::MAX as i64).contains(&s) => *field(target) = s,
+                _ => {
+                    return Err(error(
+                        wanted,
+                        text,
+                        format!("must be -1 (random) or a whole number in [0, {}]", u32::MAX),
+                    ))
+                }
+            },
+        }
+    }
+    Ok(())
+}
+
+impl Config {
+    /// Parses configuration XML; `path` names the source in errors.
+    pub fn parse(text: &str, path: &str) -> Result<Self, ConfigError> {
+        let sections = sections(text, path)?;
+        let section = |name: &str| {
+            sections
+                .iter()
+                .find(|(s, _)| s == name)
+                .map(|(_, e)| e.clone())
+                .unwrap_or_default()
+        };
+        let (planet, river, rendering) = (
+            section(SECTIONS[0]),
+            section(SECTIONS[1]),
+            section(SECTIONS[2]),
+        );
+        let folder = std::path::Path::new(path)
+            .parent()
+            .unwrap_or(std::path::Path::new(""));
+        // The river model comes first: the defaults of the other elements depend on it.
+        let mut model = Config::default().river;
+        let model_only: Section = river
+            .iter()
+            .filter(|(e, _)| e == "river-model")
+            .cloned()
+            .collect();
+        read_section(
+            (SECTIONS[1], &model_only),
+            RIVER,
+            &mut model,
+            (path, folder),
+        )?;
+        let mut config = Config::defaults_for(model.model);
+        // The default image is relative to the working folder; one written in the file to the file's.
+        read_section(
+            (SECTIONS[0], &planet),
+            PLANET,
+            &mut config.planet,
+            (path, folder),
+        )?;
+        read_section(
+            (SECTIONS[1], &river),
+            RIVER,
+            &mut config.river,
+            (path, folder),
+        )?;
+        read_section(
+            (SECTIONS[2], &rendering),
+            RENDERING,
+            &mut config.rendering,
+            (path, folder),
+        )?;
+        config.check(path)?;
+        Ok(config)
+    }
+
+    /// The rules between elements.
+    fn check(&self, path: &str) -> Result<(), ConfigError> {
+        let error = |element: &str, value: String, expected: String| ConfigError::Value {
+            path: path.to_string(),
+            element: element.to_string(),
+            value,
+            expected,
+        };
+        let (planet, river, rendering) = (&self.planet, &self.river, &self.rendering);
+        if planet.sea_level_height <= planet.ocean_height
+            || planet.sea_level_height >= planet.continent_height
+        {
+            return Err(error(
+                "sea-level-height",
+                planet.sea_level_height.to_string(),
+                format!(
+                    "must lie between ocean-height ({}) and continent-height ({})",
+                    planet.ocean_height, planet.continent_height
+                ),
+            ));
+        }
+        let widest = river.starting_width * river.ending_factor.max(1.0);
+        if river.influence_distance <= widest * 0.5 {
+            return Err(error(
+                "influence-distance",
+                river.influence_distance.to_string(),
+                format!(
+                    "must exceed half the widest river (starting-width x ending-factor / 2 = {})",
+                    widest * 0.5
+                ),
+            ));
+        }
+        if river.min_width > river.starting_width {
+            return Err(error(
+                "min-width",
+                river.min_width.to_string(),
+                format!("must not exceed starting-width ({})", river.starting_width),
+            ));
+        }
+        // Lattice keys are 32-bit signed integers on the GPU (planet::detail): the finest lattice must keep its
+        // cells per face edge, with the border, below 2^31.
+        let deepest = MAX_LATTICE_CELLS.ilog2() - (rendering.vertices - 1).ilog2();
+        if rendering.max_level_of_detail > deepest {
+            return Err(error(
+                "max-level-of-detail",
+                rendering.max_level_of_detail.to_string(),
+                format!(
+                    "must be at most {deepest} with vertices {} (at most 2^30 lattice cells per face edge)",
+                    rendering.vertices
+                ),
+            ));
+        }
+        if self.base_level().is_none() {
+            return Err(error(
+                "base-resolution",
+                self.planet.base_resolution.to_string(),
+                self.base_resolution_rule(),
+            ));
+        }
+        Ok(())
+    }
+}
