@@ -133,3 +133,46 @@ pub fn enumerate(options: &ContextOptions) -> Result<(String, Vec<AdapterInfo>),
     );
     Ok((version, result?))
 }
+
+/// A warning for a driver setting known to break this renderer: lavapipe (llvmpipe) told to use vectors narrower
+/// than 256 bits (`LP_NATIVE_VECTOR_WIDTH`, set in `width`; what it picks by itself on CPUs without AVX2) corrupts
+/// its heap in the terrain pass (docs/rendering.md, "Vertex capture"; issue 16), so the crash that follows is
+/// explained first.
+pub(super) fn driver_warning(adapter: &AdapterInfo, width: Option<&str>) -> Option<String> {
+    let narrow = width
+        .and_then(|w| w.trim().parse::<u32>().ok())
+        .is_some_and(|w| w < 256);
+    (adapter.driver_name == "llvmpipe" && narrow).then(|| {
+        format!(
+            "LP_NATIVE_VECTOR_WIDTH={}: lavapipe with vectors narrower than 256 bits corrupts its heap in the \
+             terrain pass and aborts on the first frame (docs/rendering.md, \"Vertex capture\"); unset it",
+            width.unwrap_or_default().trim()
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn adapter(driver_name: &str) -> AdapterInfo {
+        AdapterInfo {
+            name: "test".into(),
+            device_type: "CPU".into(),
+            api_version: "1.3.0".into(),
+            driver_name: driver_name.into(),
+            driver_info: String::new(),
+            features: FeatureReport { checks: Vec::new() },
+            chosen: true,
+        }
+    }
+
+    #[test]
+    fn narrow_lavapipe_vectors_are_warned_about_and_nothing_else() {
+        let warning = driver_warning(&adapter("llvmpipe"), Some("128")).unwrap();
+        assert!(warning.contains("LP_NATIVE_VECTOR_WIDTH=128"), "{warning}");
+        assert!(driver_warning(&adapter("llvmpipe"), Some("256")).is_none());
+        assert!(driver_warning(&adapter("llvmpipe"), None).is_none());
+        assert!(driver_warning(&adapter("NVIDIA"), Some("128")).is_none());
+    }
+}

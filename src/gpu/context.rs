@@ -255,6 +255,12 @@ impl Context {
         let timeline = Timeline::new(&device)?;
         let debug_device =
             validation_enabled.then(|| ext::debug_utils::Device::new(&instance, &device));
+        if let Some(warning) = super::adapter::driver_warning(
+            &adapter,
+            std::env::var("LP_NATIVE_VECTOR_WIDTH").ok().as_deref(),
+        ) {
+            log::warn!("{warning}");
+        }
         log::info!(
             "using '{}' (validation {})",
             adapter.name,
