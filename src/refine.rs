@@ -9,10 +9,10 @@ use bytemuck::{Pod, Zeroable};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
-        pipeline::{BufferSetLayout, ComputePipeline},
-        BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+        pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
+        Access, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc, ImageUse,
+        MemoryLocation, Recorder,
     },
-    gpu::{Access, Extent2D, Format, ImageUse},
     planet::{cube::PatchId, detail::PatchHeights, Planet},
     shaders,
 };
@@ -96,11 +96,15 @@ impl HeightRefiner {
         let jobs_layout = BufferSetLayout::new(ctx, 2, "height refinement jobs and ranges")?;
         let pipeline = ComputePipeline::new(
             ctx,
-            shaders::HEIGHTS_REFINE_COMP,
-            "height refinement",
-            &[bindless.layout, jobs_layout.layout],
-            std::mem::size_of::<RefinePush>() as u32,
-            &[vertices - 1],
+            &ComputeDesc {
+                name: "height refinement",
+                spirv: shaders::HEIGHTS_REFINE_COMP,
+                set_layouts: &[bindless.layout, jobs_layout.layout],
+                push_constant_bytes: std::mem::size_of::<RefinePush>() as u32,
+                // CELLS: cells per patch edge.
+                specialization: bytemuck::bytes_of(&(vertices - 1)),
+                full_subgroups: None,
+            },
         );
         let pipeline = match pipeline {
             Ok(p) => p,

@@ -4,7 +4,7 @@ mod common;
 
 use riverplanet::{
     gpu::{
-        pipeline::{BufferSetLayout, ComputePipeline},
+        pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
         vk, Access, BufferDesc, ImageDesc, ImageUse, MemoryLocation, Profiler,
     },
     shaders,
@@ -32,8 +32,18 @@ fn compute_dispatch_reads_back_and_is_timed() {
         })
         .unwrap();
     let sets = BufferSetLayout::new(ctx, 1, "fill set").unwrap();
-    let pipeline =
-        ComputePipeline::new(ctx, shaders::FILL_COMP, "fill", &[sets.layout], 12, &[]).unwrap();
+    let pipeline = ComputePipeline::new(
+        ctx,
+        &ComputeDesc {
+            name: "fill",
+            spirv: shaders::FILL_COMP,
+            set_layouts: &[sets.layout],
+            push_constant_bytes: 12,
+            specialization: &[],
+            full_subgroups: None,
+        },
+    )
+    .unwrap();
     let mut profiler = Profiler::new(ctx, 4, "fill timestamps").unwrap();
 
     let push: [u32; 3] = [0.5f32.to_bits(), 3.0f32.to_bits(), COUNT];

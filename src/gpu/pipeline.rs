@@ -20,9 +20,10 @@ pub fn shader_module(
     Ok(module)
 }
 
-/// Map entries for `count` consecutive `u32` specialization constants (constant_id 0, 1, ...).
-fn specialization_entries(count: usize) -> Vec<vk::SpecializationMapEntry> {
-    (0..count as u32)
+/// Map entries for the consecutive `u32` specialization constants in `data` (constant_id 0, 1, ...).
+fn specialization_entries(data: &[u8]) -> Vec<vk::SpecializationMapEntry> {
+    debug_assert!(data.len() % 4 == 0, "specialization constants are u32s");
+    (0..(data.len() / 4) as u32)
         .map(|i| vk::SpecializationMapEntry {
             constant_id: i,
             offset: i * 4,
@@ -69,52 +70,30 @@ pub struct ComputePipeline {
     pub layout: vk::PipelineLayout,
 }
 
+/// What a compute pipeline needs, as [`GraphicsDesc`] says it for graphics.
+pub struct ComputeDesc<'a> {
+    pub name: &'a str,
+    pub spirv: &'a [u8],
+    pub set_layouts: &'a [vk::DescriptorSetLayout],
+    pub push_constant_bytes: u32,
+    /// The shader's specialization constants: the bytes (`bytemuck::bytes_of`) of a `#[repr(C)]` Pod struct or
+    /// array of `u32`s, field k being `constant_id` k; empty for none.
+    pub specialization: &'a [u8],
+    /// For a shader that relies on full subgroups of exactly this many invocations (Vulkan 1.3
+    /// computeFullSubgroups and a required subgroup size; the workgroup size must be a multiple of it).
+    pub full_subgroups: Option<u32>,
+}
+
 impl ComputePipeline {
-    /// Builds a pipeline from SPIR-V with the given set layouts, push-constant size, and `u32` specialization
-    /// constants (constant_id 0, 1, ...).
-    pub fn new(
-        ctx: &Context,
-        spirv: &[u8],
-        name: &str,
-        set_layouts: &[vk::DescriptorSetLayout],
-        push_constant_bytes: u32,
-        specialization: &[u32],
-    ) -> Result<Self, GpuError> {
-        let layout = (set_layouts, push_constant_bytes);
-        Self::with_subgroups(ctx, spirv, name, layout, specialization, None)
-    }
-
-    /// As [`ComputePipeline::new`], for a shader that relies on full subgroups of exactly `subgroup_size`
-    /// invocations (Vulkan 1.3 computeFullSubgroups and a required subgroup size; the workgroup size must be a
-    /// multiple of it).
-    pub fn with_full_subgroups(
-        ctx: &Context,
-        spirv: &[u8],
-        name: &str,
-        set_layouts: &[vk::DescriptorSetLayout],
-        push_constant_bytes: u32,
-        specialization: &[u32],
-        subgroup_size: u32,
-    ) -> Result<Self, GpuError> {
-        let layout = (set_layouts, push_constant_bytes);
-        Self::with_subgroups(
-            ctx,
-            spirv,
+    pub fn new(ctx: &Context, desc: &ComputeDesc) -> Result<Self, GpuError> {
+        let ComputeDesc {
             name,
-            layout,
+            spirv,
+            set_layouts,
+            push_constant_bytes,
             specialization,
-            Some(subgroup_size),
-        )
-    }
-
-    fn with_subgroups(
-        ctx: &Context,
-        spirv: &[u8],
-        name: &str,
-        (set_layouts, push_constant_bytes): (&[vk::DescriptorSetLayout], u32),
-        specialization: &[u32],
-        subgroup_size: Option<u32>,
-    ) -> Result<Self, GpuError> {
+            full_subgroups: subgroup_size,
+        } = *desc;
         let module = shader_module(ctx, spirv, name)?;
         let ranges = [vk::PushConstantRange::default()
             .stage_flags(vk::ShaderStageFlags::COMPUTE)
@@ -135,10 +114,10 @@ impl ComputePipeline {
                 return Err(e);
             }
         };
-        let entries = specialization_entries(specialization.len());
+        let entries = specialization_entries(specialization);
         let spec = vk::SpecializationInfo::default()
             .map_entries(&entries)
-            .data(bytemuck::cast_slice(specialization));
+            .data(specialization);
         let mut required = vk::PipelineShaderStageRequiredSubgroupSizeCreateInfo::default()
             .required_subgroup_size(subgroup_size.unwrap_or(0));
         let mut stage = vk::PipelineShaderStageCreateInfo::default()
@@ -191,8 +170,8 @@ pub struct GraphicsDesc<'a> {
     pub fragment: &'a [u8],
     pub set_layouts: &'a [vk::DescriptorSetLayout],
     pub push_constant_bytes: u32,
-    /// `u32` specialization constants given to every stage (constant_id 0, 1, ...).
-    pub specialization: &'a [u32],
+    /// Specialization constants given to every stage, as [`ComputeDesc::specialization`].
+    pub specialization: &'a [u8],
     pub color_format: vk::Format,
     pub depth_format: vk::Format,
     pub depth_write: bool,
@@ -251,10 +230,10 @@ impl GraphicsPipeline {
             let vertex = make(desc.vertex, "vertex")?;
             let geometry = desc.geometry.map(|g| make(g, "geometry")).transpose()?;
             let fragment = make(desc.fragment, "fragment")?;
-            let entries = specialization_entries(desc.specialization.len());
+            let entries = specialization_entries(desc.specialization);
             let spec = vk::SpecializationInfo::default()
                 .map_entries(&entries)
-                .data(bytemuck::cast_slice(desc.specialization));
+                .data(desc.specialization);
             let stage = |s: vk::ShaderStageFlags, m: vk::ShaderModule| {
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(s)

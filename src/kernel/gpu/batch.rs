@@ -3,10 +3,10 @@
 
 use super::{create_river_texture, KernelBatch, KernelVariant, RiverKernel, RIVER_TEXTURE_LAYERS};
 use crate::{
-    gpu::Access,
     gpu::{
         bindless::{Bindless, Slot},
-        Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler, ScopeTiming,
+        Access, Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler,
+        ScopeTiming,
     },
     kernel::{KernelParams, ParentQuadrant, PatchJob, RiverTexel},
 };

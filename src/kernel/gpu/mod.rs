@@ -18,10 +18,10 @@ use super::{KernelParams, ParentQuadrant, PatchJob, RiverSample};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
-        pipeline::{BufferSetLayout, ComputePipeline},
-        Buffer, BufferDesc, Context, GpuError, Image, ImageDesc, MemoryLocation, Recorder,
+        pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
+        Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc,
+        ImageUse, MemoryLocation, Recorder,
     },
-    gpu::{Access, Extent2D, Format, ImageUse},
     shaders,
 };
 
@@ -50,6 +50,17 @@ const _: () = assert!(std::mem::size_of::<PushParams>() == 24);
 
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
+/// The tiled kernel's specialization constants (glsl/kernel_tiled.comp, constant_id 0 to 4 in field order).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TiledConstants {
+    invocations: u32,
+    block_x: u32,
+    block_y: u32,
+    tile_size: u32,
+    subgroup_size: u32,
+}
+
 pub const RIVER_TEXTURE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 
@@ -92,34 +103,45 @@ impl RiverKernel {
         let push = std::mem::size_of::<PushParams>() as u32;
         let simple = ComputePipeline::new(
             ctx,
-            shaders::KERNEL_SIMPLE_COMP,
-            "river kernel simple",
-            &layouts,
-            push,
-            &[tuning.simple_workgroup],
+            &ComputeDesc {
+                name: "river kernel simple",
+                spirv: shaders::KERNEL_SIMPLE_COMP,
+                set_layouts: &layouts,
+                push_constant_bytes: push,
+                // The workgroup size.
+                specialization: bytemuck::bytes_of(&tuning.simple_workgroup),
+                full_subgroups: None,
+            },
         )?;
         let reach = ComputePipeline::new(
             ctx,
-            shaders::KERNEL_REACH_COMP,
-            "river kernel reach masks",
-            &tiled_layouts,
-            push,
-            &tuning.tiled_block,
+            &ComputeDesc {
+                name: "river kernel reach masks",
+                spirv: shaders::KERNEL_REACH_COMP,
+                set_layouts: &tiled_layouts,
+                push_constant_bytes: push,
+                // BLOCK_X, BLOCK_Y.
+                specialization: bytemuck::bytes_of(&tuning.tiled_block),
+                full_subgroups: None,
+            },
         )?;
-        let tiled = ComputePipeline::with_full_subgroups(
+        let tiled_constants = TiledConstants {
+            invocations: tuning.tiled_invocations(),
+            block_x: tuning.tiled_block[0],
+            block_y: tuning.tiled_block[1],
+            tile_size: tuning.tile_size,
+            subgroup_size: ctx.subgroup.max_size,
+        };
+        let tiled = ComputePipeline::new(
             ctx,
-            shaders::KERNEL_TILED_COMP,
-            "river kernel tiled",
-            &tiled_layouts,
-            push,
-            &[
-                tuning.tiled_invocations(),
-                tuning.tiled_block[0],
-                tuning.tiled_block[1],
-                tuning.tile_size,
-                ctx.subgroup.max_size,
-            ],
-            ctx.subgroup.max_size,
+            &ComputeDesc {
+                name: "river kernel tiled",
+                spirv: shaders::KERNEL_TILED_COMP,
+                set_layouts: &tiled_layouts,
+                push_constant_bytes: push,
+                specialization: bytemuck::bytes_of(&tiled_constants),
+                full_subgroups: Some(ctx.subgroup.max_size),
+            },
         )?;
         Ok(Self {
             simple,

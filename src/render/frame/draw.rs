@@ -12,8 +12,10 @@ use super::{
     FrameStats, Renderer,
 };
 use crate::{
-    gpu::{pipeline::RenderTarget, Buffer, BufferDesc, GpuError, MemoryLocation, Recorder},
-    gpu::{Access, ImageUse},
+    gpu::{
+        pipeline::RenderTarget, Access, Buffer, BufferDesc, GpuError, ImageUse, MemoryLocation,
+        Recorder,
+    },
     planet::cube::{PatchId, EDGES},
     runtime::{camera::Camera, lod::Selected},
 };

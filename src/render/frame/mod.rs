@@ -188,7 +188,7 @@ impl<'w> Renderer<'w> {
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
                     push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                    specialization: &[water as u32],
+                    specialization: bytemuck::bytes_of(&(water as u32)),
                     color_format,
                     depth_format,
                     depth_write: !water,

@@ -15,9 +15,10 @@ use std::mem::size_of;
 use super::FramePush;
 use crate::{
     gpu::{
-        pipeline::ComputePipeline, Buffer, BufferDesc, Context, GpuError, MemoryLocation, Recorder,
+        pipeline::{ComputeDesc, ComputePipeline},
+        Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout,
+        DrawIndexedIndirectCommand, GpuError, MemoryLocation, Recorder,
     },
-    gpu::{Access, DescriptorSet, DescriptorSetLayout, DrawIndexedIndirectCommand},
     render::mesh::QuadrantMesh,
     shaders,
 };
@@ -40,11 +41,14 @@ impl VertexCache {
     pub(super) fn new(ctx: &Context, layouts: &[DescriptorSetLayout]) -> Result<Self, GpuError> {
         let pipeline = ComputePipeline::new(
             ctx,
-            shaders::VERTEX_CACHE_COMP,
-            "vertex cache",
-            layouts,
-            std::mem::size_of::<FramePush>() as u32,
-            &[],
+            &ComputeDesc {
+                name: "vertex cache",
+                spirv: shaders::VERTEX_CACHE_COMP,
+                set_layouts: layouts,
+                push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+                specialization: &[],
+                full_subgroups: None,
+            },
         )?;
         Ok(Self { pipeline })
     }
