@@ -24,6 +24,7 @@ pub trait Named: Sized + Copy + PartialEq + 'static {
 mod tests {
     use super::Named;
     use crate::{
+        config::{LodRule, RiverModel},
         kernel::gpu::KernelVariant,
         render::{presets::Preset, ViewMode, WaterMode},
     };
@@ -43,5 +44,7 @@ mod tests {
         round_trip::<ViewMode>();
         round_trip::<KernelVariant>();
         round_trip::<Preset>();
+        round_trip::<LodRule>();
+        round_trip::<RiverModel>();
     }
 }

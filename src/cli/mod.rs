@@ -475,13 +475,11 @@ fn positive_count(text: &str) -> Result<usize, String> {
 }
 
 fn parse_lod_rule(text: &str) -> Result<LodRule, String> {
-    match text {
-        "screen-space-error" => Ok(LodRule::ScreenSpaceError),
-        "distance" => Ok(LodRule::Distance),
-        _ => Err(format!(
+    LodRule::from_name(text).ok_or_else(|| {
+        format!(
             "'{text}' is not a level-of-detail rule: screen-space-error or distance (the thesis's Eq. 6.1)"
-        )),
-    }
+        )
+    })
 }
 
 /// An angle above the horizon in degrees, -90 to 90.

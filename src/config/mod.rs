@@ -82,6 +82,11 @@ pub enum RiverModel {
     Drainage,
 }
 
+impl crate::named::Named for RiverModel {
+    const ALL: &'static [(&'static str, Self)] =
+        &[("thesis", Self::Thesis), ("drainage", Self::Drainage)];
+}
+
 /// `<river-attributes>`: Table 6.1 plus the river-generation parameters of Chapter 5.
 #[derive(Clone, Debug, Serialize)]
 pub struct RiverConfig {
@@ -122,6 +127,13 @@ pub enum LodRule {
     ScreenSpaceError,
     /// The thesis's Eq. 6.1 (the default): refine while nearer than radius x switch factor / 2^level.
     Distance,
+}
+
+impl crate::named::Named for LodRule {
+    const ALL: &'static [(&'static str, Self)] = &[
+        ("screen-space-error", Self::ScreenSpaceError),
+        ("distance", Self::Distance),
+    ];
 }
 
 /// `<rendering-attributes>`: Table 6.1 plus the run-time budgets.

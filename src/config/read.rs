@@ -8,9 +8,10 @@ use std::fmt;
 use xml::reader::{EventReader, XmlEvent};
 
 use super::{
-    Config, ConfigError, LodRule, PlanetConfig, RenderingConfig, RiverConfig, RiverModel,
-    MAX_LATTICE_CELLS, MAX_LEVEL_OF_DETAIL,
+    Config, ConfigError, PlanetConfig, RenderingConfig, RiverConfig, MAX_LATTICE_CELLS,
+    MAX_LEVEL_OF_DETAIL,
 };
+use crate::named::Named;
 
 /// A closed or open numeric range for messages and checks.
 #[derive(Clone, Copy, Debug)]
@@ -56,8 +57,8 @@ enum Param<S> {
     /// A whole number of the form 2^n + 1 in [min, max].
     Grid(&'static str, u32, u32, fn(&mut S) -> &mut u32),
     Flag(&'static str, fn(&mut S) -> &mut bool),
-    /// One of the names; the setter takes the index of the one given.
-    Choice(&'static str, &'static [&'static str], fn(&mut S, usize)),
+    /// One of a [`Named`] set's names: the setter sets the value named, or says which names there are.
+    Choice(&'static str, fn(&mut S, &str) -> Result<(), String>),
     /// A path, relative to the file's folder.
     Path(&'static str, fn(&mut S) -> &mut String),
     /// -1 (pick one at start) or a 32-bit seed.
@@ -78,16 +79,15 @@ impl<S> Param<S> {
     }
 }
 
-const RIVER_MODELS: [(&str, RiverModel); 2] = [
-    ("thesis", RiverModel::Thesis),
-    ("drainage", RiverModel::Drainage),
-];
-const LOD_RULES: [(&str, LodRule); 2] = [
-    ("screen-space-error", LodRule::ScreenSpaceError),
-    ("distance", LodRule::Distance),
-];
-const RIVER_MODEL_NAMES: [&str; 2] = [RIVER_MODELS[0].0, RIVER_MODELS[1].0];
-const LOD_RULE_NAMES: [&str; 2] = [LOD_RULES[0].0, LOD_RULES[1].0];
+/// Sets `field` to the value `text` names (any case), or says which names there are.
+fn choose<T: Named>(text: &str, field: &mut T) -> Result<(), String> {
+    let value = T::from_name(&text.to_ascii_lowercase()).ok_or_else(|| {
+        let names: Vec<&str> = T::ALL.iter().map(|(n, _)| *n).collect();
+        format!("must be one of {}", names.join(", "))
+    })?;
+    *field = value;
+    Ok(())
+}
 
 /// `<planet-attributes>`.
 const PLANET: &[Param<PlanetConfig>] = &[
@@ -125,9 +125,7 @@ const PLANET: &[Param<PlanetConfig>] = &[
 
 /// `<river-attributes>`.
 const RIVER: &[Param<RiverConfig>] = &[
-    Param::Choice("river-model", &RIVER_MODEL_NAMES, |c, i| {
-        c.model = RIVER_MODELS[i].1
-    }),
+    Param::Choice("river-model", |c, text| choose(text, &mut c.model)),
     Param::Number("source-area", Range::Positive, |c| &mut c.source_area),
     Param::Number("lake-depth", Range::Positive, |c| &mut c.lake_depth),
     Param::Number("influence-distance", Range::Positive, |c| {
@@ -166,8 +164,8 @@ const RENDERING: &[Param<RenderingConfig>] = &[
     Param::Number("level-of-detail-switch-factor", Range::Positive, |c| {
         &mut c.level_of_detail_switch_factor
     }),
-    Param::Choice("level-of-detail-rule", &LOD_RULE_NAMES, |c, i| {
-        c.level_of_detail_rule = LOD_RULES[i].1
+    Param::Choice("level-of-detail-rule", |c, text| {
+        choose(text, &mut c.level_of_detail_rule)
     }),
     Param::Number("pixel-error", Range::Positive, |c| &mut c.pixel_error),
     Param::Whole("max-resident-patches", 16, 1 << 20, |c| {
@@ -193,14 +191,15 @@ const SECTIONS: [&str; 3] = [
 
 /// Every element of every section, as (section, element): what docs/configuration.md must document.
 pub fn elements() -> Vec<(&'static str, &'static str)> {
-    let names = |params: Vec<&'static str>, section| params.into_iter().map(move |n| (section, n));
-    names(PLANET.iter().map(Param::name).collect(), SECTIONS[0])
-        .chain(names(RIVER.iter().map(Param::name).collect(), SECTIONS[1]))
-        .chain(names(
-            RENDERING.iter().map(Param::name).collect(),
-            SECTIONS[2],
-        ))
-        .collect()
+    fn of<S>(section: &'static str, table: &[Param<S>]) -> Vec<(&'static str, &'static str)> {
+        table.iter().map(|p| (section, p.name())).collect()
+    }
+    [
+        of(SECTIONS[0], PLANET),
+        of(SECTIONS[1], RIVER),
+        of(SECTIONS[2], RENDERING),
+    ]
+    .concat()
 }
 
 /// Strips what the thesis's C++ file format tolerated: surrounding space, a C float suffix, a stray leading `>`.
@@ -379,18 +378,8 @@ fn read_section<S>(
                 "false" | "0" | "no" => *field(target) = false,
                 _ => return Err(error(wanted, text, "must be true or false".into())),
             },
-            Param::Choice(_, names, set) => {
-                let lower = value.to_ascii_lowercase();
-                match names.iter().position(|n| *n == lower) {
-                    Some(i) => set(target, i),
-                    None => {
-                        return Err(error(
-                            wanted,
-                            text,
-                            format!("must be one of {}", names.join(", ")),
-                        ))
-                    }
-                }
+            Param::Choice(_, set) => {
+                set(target, value).map_err(|expected| error(wanted, text, expected))?
             }
             // A path written in the file is relative to the file's folder, so the file works from any folder.
             Param::Path(_, field) => {
