@@ -129,10 +129,10 @@ impl Access {
 
     /// The layout of an image for this use: GENERAL for images shaders use (module doc), else the optimal one.
     pub(crate) fn layout(self, shader_visible: bool) -> vk::ImageLayout {
-        match (self, shader_visible) {
-            (Access::Nothing, _) => vk::ImageLayout::UNDEFINED,
-            (_, true) => vk::ImageLayout::GENERAL,
-            (access, false) => access.optimal_layout(),
+        if shader_visible && self != Access::Nothing {
+            vk::ImageLayout::GENERAL
+        } else {
+            self.optimal_layout()
         }
     }
 }
@@ -211,15 +211,14 @@ pub(crate) fn image_barrier(
     usage: &ImageUse,
 ) -> vk::ImageMemoryBarrier2<'static> {
     let layout = |accesses: &[Access]| {
-        let layouts: Vec<_> = accesses.iter().map(|a| a.layout(shader_visible)).collect();
+        let first = accesses
+            .first()
+            .map_or(vk::ImageLayout::UNDEFINED, |a| a.layout(shader_visible));
         debug_assert!(
-            layouts.windows(2).all(|w| w[0] == w[1]),
+            accesses.iter().all(|a| a.layout(shader_visible) == first),
             "uses {accesses:?} need different layouts"
         );
-        layouts
-            .first()
-            .copied()
-            .unwrap_or(vk::ImageLayout::UNDEFINED)
+        first
     };
     let (src_stage, src_access) = side(usage.before, true);
     let (dst_stage, dst_access) = side(usage.after, false);
