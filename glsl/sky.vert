@@ -1,17 +1,11 @@
 #version 460
-// Beyond the thesis: the sky as a dome of rings around the camera's nadir with the scattering marched per vertex
-// (O'Neil 2005, GPU Gems 2 ch. 16, with the transmittance table of atmosphere.glsl): about five thousand vertices
-// instead of a march per sky pixel. The rings span the directions that can show air, from the sphere of the lowest
-// terrain through the horizon of sea level (where they crowd, the limb and the bright horizon band change fastest)
-// to the top of the shell (or the zenith from inside it). Drawn at the far plane (depth 0 with reversed Z), so
-// only pixels no surface covered pass the depth test; directions outside the dome keep the clear colour (space,
-// and holes in the surface stay visible for bench::holes).
+// Beyond the thesis: the sky dome's vertex, marched by sky_dome.comp this frame. Drawn at the far plane (depth 0
+// with reversed Z), so only pixels no surface covered pass the depth test; directions outside the dome keep the
+// clear colour (space, and holes in the surface stay visible for bench::holes).
 #include "terrain_common.glsl"
-#include "atmosphere.glsl"
+#include "sky_vertex.glsl"
 
-layout(constant_id = 0) const uint RINGS = 48;
-layout(constant_id = 1) const uint SEGMENTS = 96;
-const int SKY_STEPS = 16;
+layout(set = 1, binding = 6, std430) readonly buffer Dome { SkyVertex dome[]; };
 
 layout(location = 0) out vec3 vView;
 layout(location = 1) out vec3 vRayleigh;
@@ -19,32 +13,11 @@ layout(location = 2) out vec3 vMie;
 layout(location = 3) out vec3 vTransmittance;
 
 void main() {
-    uint ring = uint(gl_VertexIndex) / (SEGMENTS + 1);
-    uint segment = uint(gl_VertexIndex) % (SEGMENTS + 1);
-    Air a = air();
-    vec3 eye = frame.camera.xyz;
-    float r = length(eye);
-    vec3 down = -eye / r;
-    // Angles from the nadir: the lowest terrain's sphere, the horizon of sea level, the top of the shell.
-    float thetaInner = asin(min((frame.planet.x + frame.planet.w) / r, 1.0));
-    float thetaHorizon = asin(min(a.bottom / r, 1.0));
-    float thetaTop = r > a.top ? asin(a.top / r) : PI;
-    float x = float(max(ring, 1u) - 1u) / float(RINGS - 1u);
-    // Ring 0 lies far enough out that its chords stay outside the lowest terrain's sphere.
-    float theta = ring == 0u ? atan(tan(thetaInner) / cos(PI / float(SEGMENTS))) : mix(thetaHorizon, thetaTop, x * x);
-    float phi = 2.0 * PI * float(segment) / float(SEGMENTS);
-    vec3 e1 = normalize(cross(down, abs(down.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
-    vec3 e2 = cross(down, e1);
-    vec3 dir = down * cos(theta) + (e1 * cos(phi) + e2 * sin(phi)) * sin(theta);
-    // A ray into the sea-level sphere stops there.
-    float b = dot(eye, dir);
-    float disc = b * b - (r * r - a.bottom * a.bottom);
-    float ground = disc > 0.0 ? -b - sqrt(disc) : -1.0;
-    Scattering s = scatter(a, eye, dir, ground > 0.0 ? ground : 1e30, SKY_STEPS, false);
-    vView = dir;
-    vRayleigh = s.rayleigh;
-    vMie = s.mie;
-    vTransmittance = s.transmittance;
+    SkyVertex v = dome[gl_VertexIndex];
+    vView = v.direction.xyz;
+    vRayleigh = v.rayleigh.xyz;
+    vMie = v.mie.xyz;
+    vTransmittance = v.transmittance.xyz;
     // A direction (w = 0) projects to depth 0 with the infinite reversed-Z projection.
-    gl_Position = frame.viewProjection * vec4(dir, 0.0);
+    gl_Position = frame.viewProjection * vec4(v.direction.xyz, 0.0);
 }

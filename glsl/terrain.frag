@@ -18,14 +18,6 @@ float hash(vec3 p) {
     return fract(p.x * p.y * p.z * (p.x + p.y + p.z));
 }
 
-float noise(vec3 x) {
-    vec3 i = floor(x);
-    vec3 f = fract(x);
-    f = f * f * (3.0 - 2.0 * f);
-    return mix(mix(mix(hash(i), hash(i + vec3(1, 0, 0)), f.x), mix(hash(i + vec3(0, 1, 0)), hash(i + vec3(1, 1, 0)), f.x), f.y),
-               mix(mix(hash(i + vec3(0, 0, 1)), hash(i + vec3(1, 0, 1)), f.x), mix(hash(i + vec3(0, 1, 1)), hash(i + vec3(1, 1, 1)), f.x), f.y), f.z);
-}
-
 const vec3 DIRT = vec3(0.45, 0.36, 0.25);
 const vec3 SAND = vec3(0.76, 0.70, 0.50);
 const vec3 GRASS = vec3(0.26, 0.45, 0.18);
@@ -93,13 +85,30 @@ vec3 levelColour(float level) {
 // apart that cross-fade (flow mapping, Vlachos 2010), so that a flow varying in space never stretches them.
 const float FLOW_PERIOD = 2.0;
 
-float rippleHeight(vec3 q) { return noise(q) + 0.5 * noise(q * 2.3 + 11.0); }
+// Value noise and its gradient from the same eight lattice values (the interpolant's derivative, Quilez):
+// the ripples' normals without the finite differences' four evaluations per octave.
+vec4 noiseGradient(vec3 x) {
+    vec3 i = floor(x);
+    vec3 f = fract(x);
+    vec3 u = f * f * (3.0 - 2.0 * f);
+    vec3 du = 6.0 * f * (1.0 - f);
+    float a = hash(i), b = hash(i + vec3(1, 0, 0)), c = hash(i + vec3(0, 1, 0)), d = hash(i + vec3(1, 1, 0));
+    float e = hash(i + vec3(0, 0, 1)), g = hash(i + vec3(1, 0, 1)), h = hash(i + vec3(0, 1, 1)), k = hash(i + vec3(1, 1, 1));
+    float kx = b - a, ky = c - a, kz = e - a;
+    float kxy = a - b - c + d, kyz = a - c - e + h, kzx = a - b - e + g;
+    float kxyz = -a + b + c - d + e - g - h + k;
+    float value = a + kx * u.x + ky * u.y + kz * u.z + kxy * u.x * u.y + kyz * u.y * u.z + kzx * u.z * u.x
+                + kxyz * u.x * u.y * u.z;
+    vec3 gradient = du * vec3(kx + kxy * u.y + kzx * u.z + kxyz * u.y * u.z,
+                              ky + kyz * u.z + kxy * u.x + kxyz * u.z * u.x,
+                              kz + kzx * u.x + kyz * u.y + kxyz * u.x * u.y);
+    return vec4(gradient, value);
+}
 
-vec3 rippleGradient(vec3 q) {
-    const float e = 0.25;
-    float h = rippleHeight(q);
-    return vec3(rippleHeight(q + vec3(e, 0.0, 0.0)) - h, rippleHeight(q + vec3(0.0, e, 0.0)) - h,
-                rippleHeight(q + vec3(0.0, 0.0, e)) - h) / e;
+// The ripples' height field, two octaves, and its gradient (xyz) with its value (w).
+vec4 ripple(vec3 q) {
+    vec4 fine = noiseGradient(q * 2.3 + 11.0);
+    return noiseGradient(q) + 0.5 * vec4(fine.xyz * 2.3, fine.w);
 }
 
 // The two phases' positions and the first one's weight.
@@ -112,9 +121,9 @@ void flowPhases(vec3 q, vec3 velocity, out vec3 q0, out vec3 q1, out float w0) {
     q1 = q - velocity * (phase1 * FLOW_PERIOD) + vec3(0.41, 0.27, 0.63);
 }
 
-// The rippled water normal around `up`, the ripples weighted by `strength`.
-vec3 flowingNormal(vec3 up, vec3 q0, vec3 q1, float w0, float strength) {
-    vec3 g = w0 * rippleGradient(q0) + (1.0 - w0) * rippleGradient(q1);
+// The rippled water normal around `up` from the two phases' ripples, weighted by `strength`.
+vec3 flowingNormal(vec3 up, vec4 r0, vec4 r1, float w0, float strength) {
+    vec3 g = w0 * r0.xyz + (1.0 - w0) * r1.xyz;
     return normalize(up - strength * (g - up * dot(g, up)));
 }
 
@@ -137,11 +146,18 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
     vec3 q0, q1;
     float w0;
     flowPhases(q, velocity, q0, q1, w0);
-    vec3 surface = visible > 0.0 ? flowingNormal(up, q0, q1, w0, 0.35 * visible) : up;
     float edge = stillWater() ? 0.0
                : river ? smoothstep(0.7, 1.0, abs(fRiver.z) / fRiver.w)
                        : 1.0 - smoothstep(0.0, 0.25 * frame.extra.z, depth);
-    float foam = edge * smoothstep(0.55, 0.8, w0 * noise(q0 * 2.0) + (1.0 - w0) * noise(q1 * 2.0));
+    // Ripples and foam only where they show (distant and open water skip the noise).
+    vec3 surface = up;
+    float foam = 0.0;
+    if (visible > 0.0 || edge > 0.0) {
+        vec4 r0 = ripple(q0);
+        vec4 r1 = ripple(q1);
+        if (visible > 0.0) surface = flowingNormal(up, r0, r1, w0, 0.35 * visible);
+        foam = edge * smoothstep(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w);
+    }
     vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
     colour = mix(colour, vec3(0.92, 0.95, 0.97), foam * 0.85);
     vec3 diffuse = max(dot(surface, sun), 0.0) * fSunlight;

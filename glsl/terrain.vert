@@ -12,7 +12,7 @@ void main() {
     PatchInstance p = instances[gl_InstanceIndex];
     TerrainVertex v;
     VertexShading shading;
-    meshVertex(p, true, v, shading);
+    meshVertex(p, gl_VertexIndex, true, v, shading);
 
     if (frame.extra.w > 0.5) {
         int n = int(frame.planet.y);

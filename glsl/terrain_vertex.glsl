@@ -244,13 +244,13 @@ void loadVertex(PatchInstance p, int id, out TerrainVertex v, out VertexShading 
     s.transmittance = vec3(inscatterBTransmittanceR.y, unpackHalf2x16(c.air.y));
 }
 
-// Mesh vertex gl_VertexIndex of `p` and its shading: from the cache where the patch has an entry, else computed
-// here (the thesis's way, Section 8.2), with the normal if `withNormal`.
-void meshVertex(PatchInstance p, bool withNormal, out TerrainVertex v, out VertexShading s) {
+// Mesh vertex `id` of `p` and its shading: from the cache where the patch has an entry, else computed here (the
+// thesis's way, Section 8.2), with the normal if `withNormal`.
+void meshVertex(PatchInstance p, int id, bool withNormal, out TerrainVertex v, out VertexShading s) {
     if (cacheIndex(p) >= 0) {
-        loadVertex(p, gl_VertexIndex, v, s);
+        loadVertex(p, id, v, s);
     } else {
-        v = terrainVertex(p, gl_VertexIndex);
+        v = terrainVertex(p, id);
         s = shadeVertex(p, v, withNormal);
     }
 }

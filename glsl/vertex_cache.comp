@@ -2,27 +2,12 @@
 // Beyond the thesis (docs/rendering.md, "The vertex cache"): one frame's grid vertices of every drawn patch, as
 // terrain.vert and water.vert would compute them (terrain_vertex.glsl), once, on all of the device's threads.
 // Workgroup (x, k): grid vertices 64x .. 64x + 63 of drawn patch k, which is instance k (render/frame/draw.rs puts
-// the drawn patches first). On the way it finds the drawn quadrants with water, the only ones the water pass
-// draws: its four indirect draws per patch start with no instance, and a quadrant that has a vertex in a river's
-// basin (unless rivers are painted) or below sea level gets one. The geometry shader still decides per triangle
-// (Section 8.4); a dry quadrant would emit nothing. Vertices of quadrants the patch does not draw (covered by finer
-// patches or culled) are skipped.
+// the drawn patches first). Vertices of quadrants the patch does not draw (covered by finer patches or culled) are
+// skipped. water_triangles.comp then finds the water triangles from it.
 #define VERTEX_CACHE_WRITER
 #include "terrain_vertex.glsl"
 
 layout(local_size_x = 64) in;
-
-// VkDrawIndexedIndirectCommand, four per patch (render/frame/vertex_cache.rs writes all but instanceCount).
-struct DrawCommand {
-    uint indexCount;
-    uint instanceCount;
-    uint firstIndex;
-    int vertexOffset;
-    uint firstInstance;
-};
-layout(set = 1, binding = 3, std430) buffer WaterDraws { DrawCommand waterDraws[]; };
-
-shared uint wetQuadrants;
 
 // The quadrants (bit 0: +i half, bit 1: +j half, as render/mesh.rs) of the cells around grid point `ij`.
 uint quadrantsAround(ivec2 ij, int n) {
@@ -44,20 +29,10 @@ void main() {
     int id = int(gl_GlobalInvocationID.x);
     PatchInstance p = instances[gl_WorkGroupID.y];
     int entry = cacheIndex(p);
-    if (gl_LocalInvocationIndex == 0) wetQuadrants = 0u;
-    barrier();
     // Only the vertices of drawn quadrants' cells (culled quadrants are not drawn, their skirts hang from them).
     uint around = id < n * n ? quadrantsAround(divMod(id, n).yx, n) : 0u;
     if ((around & uint(p.slots.z)) != 0u) {
         TerrainVertex v = terrainVertex(p, id);
         storeVertex(uint(entry * n * n + id), v, shadeVertex(p, v, true));
-        bool river = waterMode() != WATER_PAINTED && abs(v.surface.z) < v.surface.w;
-        bool sea = v.surface.x < frame.sun.w;
-        if (river || sea) atomicOr(wetQuadrants, around);
-    }
-    barrier();
-    uint q = gl_LocalInvocationIndex;
-    if (q < 4 && (wetQuadrants & uint(p.slots.z) & (1u << q)) != 0u) {
-        atomicOr(waterDraws[entry * 4 + int(q)].instanceCount, 1u);
     }
 }

@@ -19,7 +19,7 @@ void main() {
     PatchInstance p = instances[gl_InstanceIndex];
     TerrainVertex v;
     VertexShading s;
-    meshVertex(p, false, v, s);
+    meshVertex(p, gl_VertexIndex, false, v, s);
     vLocalInstance = vec4(v.local, float(gl_InstanceIndex));
     vRiver = v.surface;
     vDirectionEdge = vec4(v.direction, float(v.edge));

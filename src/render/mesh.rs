@@ -141,12 +141,16 @@ pub fn dome_mesh(rings: u32, segments: u32) -> Vec<u32> {
         .collect()
 }
 
-/// `indices` in a device-local index buffer.
+/// `indices` in a device-local index buffer (which compute shaders may read, as water_triangles.comp does).
 pub fn index_buffer(ctx: &Context, name: &str, indices: &[u32]) -> Result<Buffer, GpuError> {
     let buffer = ctx.create_buffer(&BufferDesc {
         name,
         size: std::mem::size_of_val(indices) as u64,
-        uses: &[Access::IndexRead, Access::TransferWrite],
+        uses: &[
+            Access::IndexRead,
+            Access::ComputeRead,
+            Access::TransferWrite,
+        ],
         location: MemoryLocation::GpuOnly,
     })?;
     ctx.run_and_wait(name, |rec| {

@@ -8,6 +8,7 @@ use glam::DVec3;
 
 use super::{
     shader_data::{instance, PatchInstance, NO_MORPH},
+    sky::Sky,
     vertex_cache::VertexCache,
     FrameStats, Renderer,
 };
@@ -276,26 +277,39 @@ impl Renderer<'_> {
         };
         let vertex_cache = VertexCache::buffer(ctx, cached, n)?;
         let water_draws = VertexCache::water_draws(ctx, cached, &self.quadrants)?;
+        let water_indices = VertexCache::water_indices(ctx, cached, n)?;
+        let draw_sky = self.sky().is_some();
+        let dome_vertices = match draw_sky {
+            true => Some(Sky::dome_vertices(ctx)?),
+            false => None,
+        };
         let instance_set = rec.buffer_set(
             &self.instance_layout,
             &[
                 &instance_buffer,
-                capture.as_ref().unwrap_or(&self.no_capture),
+                capture.as_ref().unwrap_or(&self.placeholder),
                 &vertex_cache,
                 &water_draws,
+                &self.indices,
+                &water_indices,
+                dome_vertices.as_ref().unwrap_or(&self.placeholder),
             ],
         )?;
         rec.free_after_completion(instance_buffer);
 
         // Section 8: terrain, then water.
-        let draw_sky = self.sky().is_some();
         let push = self.frame_push(camera);
         let sets = [self.bindless.set, instance_set];
         let push = bytemuck::bytes_of(&push);
         let scope = self.frames.profiler().begin(rec, "vertices")?;
         self.vertex_cache
-            .record(rec, (&sets, push), (&vertex_cache, &water_draws), cached, n);
+            .record(rec, (&sets, push), &vertex_cache, cached, n);
         self.frames.profiler().end(rec, scope);
+        if let (Some(sky), Some(vertices)) = (&self.sky, &dome_vertices) {
+            let scope = self.frames.profiler().begin(rec, "sky dome")?;
+            sky.record_dome(rec, (&sets, push), vertices);
+            self.frames.profiler().end(rec, scope);
+        }
         rec.free_after_completion(vertex_cache);
         // The target is cleared, so its contents are discarded; the wait for the earlier writes to it (the frame
         // before, which may still be in flight, or the swapchain's acquire, waited for at colour output) stays.
@@ -332,9 +346,9 @@ impl Renderer<'_> {
         let scope = self.frames.profiler().begin(rec, "water")?;
         if !self.wireframe_on {
             rec.draw_indexed_indirect(
-                &self.water,
+                &self.cached_water,
                 (&sets, push),
-                &self.indices,
+                &water_indices,
                 &water_draws,
                 4 * cached as u32,
             );
@@ -350,6 +364,10 @@ impl Renderer<'_> {
             }
         }
         rec.free_after_completion(water_draws);
+        rec.free_after_completion(water_indices);
+        if let Some(vertices) = dome_vertices {
+            rec.free_after_completion(vertices);
+        }
         self.frames.profiler().end(rec, scope);
         if let (true, Some(sky)) = (draw_sky, &self.sky) {
             let scope = self.frames.profiler().begin(rec, "sky")?;

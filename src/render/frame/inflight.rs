@@ -11,7 +11,7 @@ use crate::gpu::{
     GpuError,
 };
 
-/// Timestamp scopes per frame: heights, kernel, vertices, terrain, water, sky, with room to spare.
+/// Timestamp scopes per frame: heights, kernel, vertices, sky dome, terrain, water, sky, with room to spare.
 pub(super) const TIMESTAMP_SCOPES: u32 = 8;
 
 /// What a frame in flight leaves to read back once the GPU has finished it.

@@ -77,12 +77,15 @@ pub struct Renderer<'w> {
     refiner: HeightRefiner,
     terrain: GraphicsPipeline,
     water: GraphicsPipeline,
+    /// The water of patches in the vertex cache, from the triangles its passes list (no geometry shader).
+    cached_water: GraphicsPipeline,
     wireframe: GraphicsPipeline,
     /// The atmosphere's table and sky pass; `None` for a planet without air (`atmosphere-height` 0).
     sky: Option<sky::Sky>,
     instance_layout: BufferSetLayout,
-    /// Bound in place of a capture buffer when vertices are not captured.
-    no_capture: Buffer,
+    /// Bound in place of the vertex capture when vertices are not captured, and of the sky dome's vertices when
+    /// no sky is drawn.
+    placeholder: Buffer,
     vertex_cache: vertex_cache::VertexCache,
     indices: Buffer,
     quadrants: [QuadrantMesh; 4],
@@ -161,30 +164,27 @@ impl<'w> Renderer<'w> {
         let refiner = HeightRefiner::new(ctx, &bindless, n)?;
         let instance_layout = BufferSetLayout::new(
             ctx,
-            4,
-            "patch instances, vertex capture, vertex cache, water draws",
+            7,
+            "patch instances, vertex capture, vertex cache, water draws, mesh indices, water indices, sky dome",
         )?;
-        let no_capture = ctx.create_buffer(&BufferDesc {
-            name: "no vertex capture",
-            size: 16,
+        let placeholder = ctx.create_buffer(&BufferDesc {
+            name: "placeholder",
+            size: 64,
             uses: &[Access::VertexShaderWrite],
             location: MemoryLocation::GpuOnly,
         })?;
         let layouts = [bindless.layout, instance_layout.layout];
         let vertex_cache = vertex_cache::VertexCache::new(ctx, &layouts)?;
         // The terrain is drawn per quadrant without a geometry shader, back faces culled; the water pass has the
-        // geometry shader that spawns water triangles (docs/rendering.md).
-        let pipeline = |name: &str, water: bool, wireframe: bool| {
+        // geometry shader that spawns water triangles, except for the cached patches, whose water triangles the
+        // vertex cache's passes list (docs/rendering.md). Water is blended over the terrain and writes no depth.
+        let pipeline = |name: &str, vertex, geometry, water: bool, wireframe: bool| {
             GraphicsPipeline::new(
                 ctx,
                 &GraphicsDesc {
                     name,
-                    vertex: if water {
-                        shaders::WATER_VERT
-                    } else {
-                        shaders::TERRAIN_VERT
-                    },
-                    geometry: water.then_some(shaders::TERRAIN_GEOM),
+                    vertex,
+                    geometry,
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
                     push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
@@ -195,15 +195,34 @@ impl<'w> Renderer<'w> {
                     depth_test: true,
                     blend: if water { Blend::Alpha } else { Blend::None },
                     wireframe,
-                    // The terrain with its skirts is closed (render/mesh.rs); the water's geometry shader emits
-                    // triangles in either winding.
+                    // The terrain with its skirts is closed (render/mesh.rs); water triangles come in either
+                    // winding.
                     cull_back_faces: !water,
                 },
             )
         };
-        let terrain = pipeline("terrain", false, false)?;
-        let water = pipeline("water", true, false)?;
-        let wireframe = pipeline("terrain wireframe", false, true)?;
+        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, false, false)?;
+        let water = pipeline(
+            "water",
+            shaders::WATER_VERT,
+            Some(shaders::TERRAIN_GEOM),
+            true,
+            false,
+        )?;
+        let cached_water = pipeline(
+            "cached water",
+            shaders::WATER_SURFACE_VERT,
+            None,
+            true,
+            false,
+        )?;
+        let wireframe = pipeline(
+            "terrain wireframe",
+            shaders::TERRAIN_VERT,
+            None,
+            false,
+            true,
+        )?;
         let air = Atmosphere::new(
             planet.radius,
             planet.sea_level as f64,
@@ -244,10 +263,11 @@ impl<'w> Renderer<'w> {
             refiner,
             terrain,
             water,
+            cached_water,
             wireframe,
             sky,
             instance_layout,
-            no_capture,
+            placeholder,
             vertex_cache,
             indices,
             quadrants,
@@ -453,6 +473,7 @@ impl<'w> Renderer<'w> {
         self.refiner.destroy(ctx);
         self.terrain.destroy(ctx);
         self.water.destroy(ctx);
+        self.cached_water.destroy(ctx);
         self.wireframe.destroy(ctx);
         if let Some(sky) = self.sky {
             sky.destroy(ctx, &mut self.bindless);

@@ -5,25 +5,33 @@ use super::{FramePush, Renderer};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
-        pipeline::{Blend, GraphicsDesc, GraphicsPipeline},
-        Access, Buffer, Context, DescriptorSet, DescriptorSetLayout, Extent2D, Format, GpuError,
-        Image, ImageDesc, ImageUse, Recorder,
+        pipeline::{Blend, ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline},
+        Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, Extent2D, Format,
+        GpuError, Image, ImageDesc, ImageUse, MemoryLocation, Recorder,
     },
     planet::atmosphere::Atmosphere,
     render::mesh::{dome_mesh, index_buffer},
     shaders,
 };
 
-/// Rings of the sky dome (glsl/sky.vert), from the lowest terrain's sphere to the top of the shell.
+/// Rings of the sky dome (glsl/sky_dome.comp), from the lowest terrain's sphere to the top of the shell.
 const RINGS: u32 = 48;
 /// Segments of every ring.
 const SEGMENTS: u32 = 96;
+/// The dome's vertices: `RINGS + 1` rings of `SEGMENTS + 1`.
+const DOME_VERTICES: u32 = (RINGS + 1) * (SEGMENTS + 1);
+/// Bytes of one dome vertex (`SkyVertex` in glsl/sky_vertex.glsl).
+const DOME_VERTEX_BYTES: u64 = 64;
+/// Dome vertices per workgroup (`local_size_x` of sky_dome.comp).
+const WORKGROUP: u32 = 64;
 
 pub(super) struct Sky {
     /// The atmosphere's table, held while `slot` points at it (retired as the sky drops).
     _table: Image,
     slot: Slot,
     pipeline: GraphicsPipeline,
+    /// Marches the dome's vertices once a frame.
+    dome_pipeline: ComputePipeline,
     /// The dome's triangles: vertex `ring * (SEGMENTS + 1) + segment`.
     dome: Buffer,
     dome_indices: u32,
@@ -78,6 +86,17 @@ impl Sky {
             GpuError::Invalid("no bindless slot left for the atmosphere".to_string())
         })?;
         bindless.write(ctx, slot, &image, false);
+        let dome_pipeline = ComputePipeline::new(
+            ctx,
+            &ComputeDesc {
+                name: "sky dome",
+                spirv: shaders::SKY_DOME_COMP,
+                set_layouts,
+                push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+                specialization: bytemuck::bytes_of(&[RINGS, SEGMENTS]),
+                full_subgroups: None,
+            },
+        )?;
         // The dome lies at depth 0: only pixels no surface covered pass the depth test.
         let pipeline = GraphicsPipeline::new(
             ctx,
@@ -88,7 +107,7 @@ impl Sky {
                 fragment: shaders::SKY_FRAG,
                 set_layouts,
                 push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                specialization: bytemuck::bytes_of(&[RINGS, SEGMENTS]),
+                specialization: &[],
                 color_format: formats.0,
                 depth_format: formats.1,
                 depth_write: false,
@@ -102,6 +121,7 @@ impl Sky {
             _table: image,
             slot,
             pipeline,
+            dome_pipeline,
             dome,
             dome_indices: indices.len() as u32,
             height: (atmosphere.top - atmosphere.bottom) as f32,
@@ -111,6 +131,37 @@ impl Sky {
     /// The table's slot, as the shaders take it.
     pub(super) fn slot(&self) -> f32 {
         self.slot.0 as f32
+    }
+
+    /// A frame's dome vertices, for `record_dome` to fill and the sky pass to read (binding 6 of the instance set).
+    pub(super) fn dome_vertices(ctx: &Context) -> Result<Buffer, GpuError> {
+        ctx.create_buffer(&BufferDesc {
+            name: "sky dome vertices",
+            size: DOME_VERTICES as u64 * DOME_VERTEX_BYTES,
+            uses: &[Access::ComputeWrite, Access::VertexShaderRead],
+            location: MemoryLocation::GpuOnly,
+        })
+    }
+
+    /// Marches the dome's vertices into `vertices` (bound in `sets`) for this frame's camera, before the
+    /// rendering scope, and makes them visible to the sky pass.
+    pub(super) fn record_dome(
+        &self,
+        rec: &mut Recorder,
+        (sets, push): (&[DescriptorSet], &[u8]),
+        vertices: &Buffer,
+    ) {
+        rec.dispatch(
+            &self.dome_pipeline,
+            sets,
+            push,
+            [DOME_VERTICES.div_ceil(WORKGROUP), 1, 1],
+        );
+        rec.buffer_barrier(
+            vertices,
+            &[Access::ComputeWrite],
+            &[Access::VertexShaderRead],
+        );
     }
 
     /// Draws the sky (inside the frame's rendering scope).
@@ -127,6 +178,7 @@ impl Sky {
 
     pub(super) fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
         self.pipeline.destroy(ctx);
+        self.dome_pipeline.destroy(ctx);
         bindless.release(ctx, self.slot);
     }
 }

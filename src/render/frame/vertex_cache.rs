@@ -6,9 +6,10 @@
 //! in parallel. Patches beyond the cache's size, or all with `Renderer::vertex_cache` off, compute their vertices
 //! in the vertex shaders, the thesis's way.
 //!
-//! The pass also finds which drawn quadrants have water: the water pass draws a cached patch through four
-//! indirect draws, one per quadrant, that the pass gives an instance only where a vertex is in a river's basin or
-//! below sea level.
+//! A second pass (glsl/water_triangles.comp) then makes the water pass's geometry-shader choice for the cached
+//! patches from the cache (docs/rendering.md, "Water without the geometry shader"): per drawn quadrant, the list of
+//! triangles that get water and the indirect draw of that list, which the water pass draws without a geometry
+//! shader (glsl/water_surface.vert).
 
 use std::mem::size_of;
 
@@ -35,22 +36,28 @@ const WORKGROUP: u32 = 64;
 
 pub(super) struct VertexCache {
     pipeline: ComputePipeline,
+    water_triangles: ComputePipeline,
 }
 
 impl VertexCache {
     pub(super) fn new(ctx: &Context, layouts: &[DescriptorSetLayout]) -> Result<Self, GpuError> {
-        let pipeline = ComputePipeline::new(
-            ctx,
-            &ComputeDesc {
-                name: "vertex cache",
-                spirv: shaders::VERTEX_CACHE_COMP,
-                set_layouts: layouts,
-                push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                specialization: &[],
-                full_subgroups: None,
-            },
-        )?;
-        Ok(Self { pipeline })
+        let pipeline = |name, spirv| {
+            ComputePipeline::new(
+                ctx,
+                &ComputeDesc {
+                    name,
+                    spirv,
+                    set_layouts: layouts,
+                    push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+                    specialization: &[],
+                    full_subgroups: None,
+                },
+            )
+        };
+        Ok(Self {
+            pipeline: pipeline("vertex cache", shaders::VERTEX_CACHE_COMP)?,
+            water_triangles: pipeline("water triangles", shaders::WATER_TRIANGLES_COMP)?,
+        })
     }
 
     /// How many of `drawn` patches of `n` x `n` vertices one frame caches.
@@ -68,8 +75,9 @@ impl VertexCache {
         })
     }
 
-    /// The water pass's indirect draws of `patches` cached patches: per patch (instance k) its four quadrants'
-    /// grid cells, with no instance until the cache's pass finds water there. At least one draw's bytes.
+    /// The water pass's indirect draws of `patches` cached patches, as the water-triangle pass finds them: per
+    /// patch (instance k) its four quadrants' grid cells in the mesh, which that pass turns into the draws of
+    /// their water triangles. At least one draw's bytes.
     pub(super) fn water_draws(
         ctx: &Context,
         patches: usize,
@@ -97,13 +105,26 @@ impl VertexCache {
         Ok(buffer)
     }
 
-    /// Records the pass that fills `cache` and `water_draws` for instances 0 .. `patches` (which `sets` bind), and
-    /// makes them visible to the vertex shaders and the indirect draws.
+    /// The water triangles' indices of `patches` cached patches of `n` x `n` vertices: room for every grid cell
+    /// of every quadrant (`6 m^2` indices for `m = (n - 1) / 2` cells a side, as water_triangles.comp lays them
+    /// out). At least one index's bytes.
+    pub(super) fn water_indices(ctx: &Context, patches: usize, n: u32) -> Result<Buffer, GpuError> {
+        let m = (n as u64 - 1) / 2;
+        ctx.create_buffer(&BufferDesc {
+            name: "water indices",
+            size: (patches as u64 * 4 * 6 * m * m * 4).max(4),
+            uses: &[Access::ComputeWrite, Access::IndexRead],
+            location: MemoryLocation::GpuOnly,
+        })
+    }
+
+    /// Records the passes that fill `cache`, then the water indices and draws from it (all bound in `sets`), for
+    /// instances 0 .. `patches`, and makes them visible to the vertex shaders and the indexed indirect draws.
     pub(super) fn record(
         &self,
         rec: &mut Recorder,
         (sets, push): (&[DescriptorSet], &[u8]),
-        (cache, water_draws): (&Buffer, &Buffer),
+        cache: &Buffer,
         patches: usize,
         n: u32,
     ) {
@@ -116,15 +137,21 @@ impl VertexCache {
             push,
             [(n * n).div_ceil(WORKGROUP), patches as u32, 1],
         );
-        rec.buffer_barrier(cache, &[Access::ComputeWrite], &[Access::VertexShaderRead]);
         rec.buffer_barrier(
-            water_draws,
+            cache,
+            &[Access::ComputeWrite],
+            &[Access::ComputeRead, Access::VertexShaderRead],
+        );
+        rec.dispatch(&self.water_triangles, sets, push, [1, patches as u32, 1]);
+        // One barrier for the draws and their indices (lavapipe waits for all earlier work at every barrier).
+        rec.memory_barrier(
             &[Access::ComputeRead, Access::ComputeWrite],
-            &[Access::IndirectCommands],
+            &[Access::IndirectCommands, Access::IndexRead],
         );
     }
 
     pub(super) fn destroy(self, ctx: &Context) {
         self.pipeline.destroy(ctx);
+        self.water_triangles.destroy(ctx);
     }
 }
