@@ -23,6 +23,7 @@ pub mod render;
 pub mod river;
 pub mod rng;
 pub mod runtime;
+pub mod shader_types;
 pub mod world;
 
 /// SPIR-V of every shader in `glsl/`, compiled by build.rs.

@@ -4,8 +4,6 @@
 
 use std::collections::HashMap;
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
@@ -14,36 +12,12 @@ use crate::{
         MemoryLocation, Recorder,
     },
     planet::{cube::PatchId, detail::PatchHeights, Planet},
+    shader_types::{GpuRefineJob, RefinePush},
     shaders,
 };
 
 /// Format of a patch's base-height texture: one f32 per lattice point, border included.
 pub const HEIGHT_FORMAT: Format = Format::R32_SFLOAT;
-
-/// One row of the job table (std430 mirror of `RefineJob` in the shader).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct GpuRefineJob {
-    child_slot: i32,
-    parent_slot: i32,
-    face: i32,
-    level: i32,
-    x: i32,
-    y: i32,
-    range_index: i32,
-    unused: i32,
-}
-
-const _: () = assert!(std::mem::size_of::<GpuRefineJob>() == 32);
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct RefinePush {
-    seed: u32,
-    amplitude: f32,
-}
-
-const _: () = assert!(std::mem::size_of::<RefinePush>() == 8);
 
 /// A patch to refine: its id, the slot its fresh texture is bound at, and its parent's slot.
 #[derive(Clone, Copy, Debug)]

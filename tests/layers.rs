@@ -1,5 +1,6 @@
 //! The layering the architecture promises (docs/architecture.md), checked on the source: only src/gpu/ names ash or
-//! raw Vulkan (`vk::`), and only the binary's command-line code (src/main.rs, src/cli/) names clap.
+//! raw Vulkan (`vk::`), only the binary's command-line code (src/main.rs, src/cli/) names clap, the model layer
+//! names no layer above it, and runtime/ no GPU or renderer type.
 
 use std::path::{Path, PathBuf};
 
@@ -14,8 +15,9 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Every source file outside `allowed` (prefixes under src/) that contains one of `words`, with the first line.
-fn offenders(words: &[&str], allowed: &[&str]) -> Vec<String> {
+/// Every source file that `checked` accepts (by its path under the repository) and that contains one of `words`
+/// outside comments, with the first such line.
+fn offenders_where(words: &[&str], checked: impl Fn(&str) -> bool) -> Vec<String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     sources(&root.join("src"), &mut files);
@@ -28,16 +30,64 @@ fn offenders(words: &[&str], allowed: &[&str]) -> Vec<String> {
                 .unwrap()
                 .to_string_lossy()
                 .replace('\\', "/");
-            if allowed.iter().any(|a| relative.starts_with(a)) {
+            if !checked(&relative) {
                 return None;
             }
             let text = std::fs::read_to_string(path).unwrap();
             text.lines()
                 .enumerate()
+                .filter(|(_, line)| !line.trim_start().starts_with("//"))
                 .find(|(_, line)| words.iter().any(|w| line.contains(w)))
                 .map(|(n, line)| format!("{relative}:{}: {}", n + 1, line.trim()))
         })
         .collect()
+}
+
+/// Every source file outside `allowed` (prefixes under src/) that contains one of `words`.
+fn offenders(words: &[&str], allowed: &[&str]) -> Vec<String> {
+    offenders_where(words, |path| !allowed.iter().any(|a| path.starts_with(a)))
+}
+
+/// Every source file inside `layer` (prefixes under src/) that contains one of `words`.
+fn offenders_in(layer: &[&str], words: &[&str]) -> Vec<String> {
+    offenders_where(words, |path| layer.iter().any(|a| path.starts_with(a)))
+}
+
+#[test]
+fn the_model_names_no_layer_above_it_and_runtime_no_gpu_type() {
+    let model = [
+        "src/planet/",
+        "src/river/",
+        "src/drainage/",
+        "src/config/",
+        "src/rng.rs",
+        "src/shader_types.rs",
+    ];
+    let above = [
+        "kernel::",
+        "runtime::",
+        "render::",
+        "gpu::",
+        "refine::",
+        "bench::",
+        "export::",
+        "world::",
+    ];
+    let found = offenders_in(&model, &above);
+    assert!(
+        found.is_empty(),
+        "the model names a layer above it:\n{}",
+        found.join("\n")
+    );
+    let found = offenders_in(
+        &["src/runtime/"],
+        &["gpu::", "render::", "bench::", "export::"],
+    );
+    assert!(
+        found.is_empty(),
+        "runtime names a GPU or renderer type:\n{}",
+        found.join("\n")
+    );
 }
 
 #[test]

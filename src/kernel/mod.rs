@@ -11,33 +11,7 @@ pub mod cpu;
 pub mod gpu;
 pub mod workload;
 
-use bytemuck::{Pod, Zeroable};
-
-/// One river sample (6.4): position and first derivative in the patch frame, river height and full width.
-/// Two vec4s in std430 (32 bytes), which lets the shaders load it with two aligned 16-byte reads.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct RiverSample {
-    pub position: [f32; 2],
-    pub derivative: [f32; 2],
-    pub height: f32,
-    pub width: f32,
-    pub _pad: [f32; 2],
-}
-
-const _: () = assert!(std::mem::size_of::<RiverSample>() == 32);
-
-impl RiverSample {
-    pub fn new(position: [f32; 2], derivative: [f32; 2], height: f32, width: f32) -> Self {
-        Self {
-            position,
-            derivative,
-            height,
-            width,
-            _pad: [0.0; 2],
-        }
-    }
-}
+pub use crate::shader_types::RiverSample;
 
 /// The constants of Procedures 3-5, from the configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]

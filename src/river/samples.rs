@@ -9,8 +9,8 @@ use super::{
     network::{subdivide, RiverNetwork, RiverSystem, Segment, MAX_DEPTH},
 };
 use crate::{
-    kernel::RiverSample,
     planet::cube::{self, PatchId},
+    shader_types::RiverSample,
 };
 
 /// A patch's 2D frame.

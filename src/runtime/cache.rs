@@ -1,85 +1,25 @@
-//! The patch cache: for every patch whose data is on the GPU, its base-height texture and (if a river
-//! influences it) its river texture, each in a slot of the bindless array. Least recently used patches are
-//! evicted beyond the budget; the six roots stay, so every patch always has a resident ancestor to stand in for it
-//! while its own data is on the way.
+//! The patch cache: the patches whose data is resident, each with its payload (the renderer's textures and what
+//! it knows of them), and which were used when. Least recently used patches are evicted beyond the budget and
+//! handed back, for their owner to free; the six roots stay, so every patch always has a resident ancestor to
+//! stand in for it while its own data is on the way.
 
 use std::collections::HashMap;
 
-use crate::{
-    gpu::{
-        bindless::{Bindless, Slot},
-        Context, Image,
-    },
-    planet::cube::PatchId,
-};
+use crate::planet::cube::PatchId;
 
-/// A patch's resident data.
-pub struct PatchData {
-    pub base: Image,
-    pub base_slot: Slot,
-    pub river: Option<(Image, Slot)>,
-    pub samples: usize,
-    /// Whether the samples were the rivers' final detail: then children take river data from this patch (10.2).
-    pub river_final: bool,
-    /// Lowest and highest base height (with the border): whether the patch can show sea, and the bounds of its
-    /// vertices for the level of detail. Exact once known (uploaded, or read back after refinement).
-    pub height_range: (f32, f32),
-    /// The heights river beds and water can take in the patch (its samples' heights widened by the basin
-    /// depth), which may lie below the base heights where a river cuts through high ground.
-    pub river_range: Option<(f32, f32)>,
+struct Entry<D> {
+    data: D,
     last_used: u64,
 }
 
-impl PatchData {
-    pub fn new(
-        (base, base_slot): (Image, Slot),
-        river: Option<(Image, Slot)>,
-        (samples, river_final): (usize, bool),
-        height_range: (f32, f32),
-        river_range: Option<(f32, f32)>,
-    ) -> Self {
-        Self {
-            base,
-            base_slot,
-            river,
-            samples,
-            river_final,
-            height_range,
-            river_range,
-            last_used: 0,
-        }
-    }
-
-    /// Lowest and highest height a drawn vertex of the patch can have: base heights and river beds.
-    pub fn surface_range(&self) -> (f32, f32) {
-        let (lo, hi) = self.height_range;
-        self.river_range
-            .map_or((lo, hi), |(a, b)| (lo.min(a), hi.max(b)))
-    }
-
-    pub fn bytes(&self) -> u64 {
-        let size =
-            |i: &Image| (i.extent.width * i.extent.height * i.layers) as u64 * texel_bytes(i);
-        size(&self.base) + self.river.as_ref().map_or(0, |(i, _)| size(i))
-    }
-}
-
-fn texel_bytes(image: &Image) -> u64 {
-    use crate::gpu::Format;
-    match image.format {
-        Format::R32G32B32A32_SFLOAT => 16,
-        _ => 4,
-    }
-}
-
-/// Resident patches, with LRU eviction beyond `capacity` patches.
-pub struct PatchCache {
-    entries: HashMap<PatchId, PatchData>,
+/// Resident patches with payload `D`, with LRU eviction beyond `capacity` patches.
+pub struct PatchCache<D> {
+    entries: HashMap<PatchId, Entry<D>>,
     pub capacity: usize,
     frame: u64,
 }
 
-impl PatchCache {
+impl<D> PatchCache<D> {
     pub fn new(capacity: usize) -> Self {
         Self {
             entries: HashMap::new(),
@@ -98,32 +38,34 @@ impl PatchCache {
     }
 
     /// The data of a resident patch, marked as used this frame.
-    pub fn touch(&mut self, patch: &PatchId) -> Option<&PatchData> {
+    pub fn touch(&mut self, patch: &PatchId) -> Option<&D> {
         let frame = self.frame;
         self.entries.get_mut(patch).map(|e| {
             e.last_used = frame;
-            &*e
+            &e.data
         })
     }
 
-    pub fn insert(&mut self, patch: PatchId, mut data: PatchData) {
-        data.last_used = self.frame;
-        self.entries.insert(patch, data);
+    /// The data of a resident patch to change, without marking it used.
+    pub fn get_mut(&mut self, patch: &PatchId) -> Option<&mut D> {
+        self.entries.get_mut(patch).map(|e| &mut e.data)
     }
 
-    /// Replaces a resident patch's height range (the exact one, read back after its refinement).
-    pub fn set_height_range(&mut self, patch: &PatchId, range: (f32, f32)) {
-        if let Some(e) = self.entries.get_mut(patch) {
-            e.height_range = range;
-        }
+    /// Makes `patch` resident with `data`, used this frame; hands back what it held before.
+    pub fn insert(&mut self, patch: PatchId, data: D) -> Option<D> {
+        let entry = Entry {
+            data,
+            last_used: self.frame,
+        };
+        self.entries.insert(patch, entry).map(|e| e.data)
     }
 
     /// The patch itself if resident, or else its nearest resident ancestor, with its data.
-    pub fn nearest_resident(&self, patch: PatchId) -> Option<(PatchId, &PatchData)> {
+    pub fn nearest_resident(&self, patch: PatchId) -> Option<(PatchId, &D)> {
         let mut p = Some(patch);
         while let Some(q) = p {
-            if let Some(data) = self.entries.get(&q) {
-                return Some((q, data));
+            if let Some(e) = self.entries.get(&q) {
+                return Some((q, &e.data));
             }
             p = q.parent();
         }
@@ -150,17 +92,16 @@ impl PatchCache {
         self.entries.is_empty()
     }
 
-    /// Bytes of all resident patch textures.
-    pub fn bytes(&self) -> u64 {
-        self.entries.values().map(PatchData::bytes).sum()
+    /// Every resident patch's data.
+    pub fn values(&self) -> impl Iterator<Item = &D> {
+        self.entries.values().map(|e| &e.data)
     }
 
     /// Evicts least recently used patches (never the roots, never one used this frame) until at most `target`
-    /// remain (or only protected ones); their textures are freed once the GPU is done with them. Returns how many
-    /// were evicted.
-    pub fn evict_to(&mut self, target: usize, ctx: &Context, bindless: &mut Bindless) -> usize {
+    /// remain (or only protected ones), and hands their data back.
+    pub fn evict_to(&mut self, target: usize) -> Vec<D> {
         if self.entries.len() <= target {
-            return 0;
+            return Vec::new();
         }
         let mut candidates: Vec<(u64, PatchId)> = self
             .entries
@@ -170,28 +111,48 @@ impl PatchCache {
             .collect();
         candidates.sort();
         let excess = self.entries.len() - target;
-        let mut evicted = 0;
-        for (_, id) in candidates.into_iter().take(excess) {
-            if let Some(data) = self.entries.remove(&id) {
-                release(ctx, bindless, data);
-                evicted += 1;
-            }
-        }
-        evicted
+        candidates
+            .into_iter()
+            .take(excess)
+            .filter_map(|(_, id)| self.entries.remove(&id).map(|e| e.data))
+            .collect()
     }
 
-    /// Frees everything (at shutdown).
-    pub fn clear(&mut self, ctx: &Context, bindless: &mut Bindless) {
-        for (_, data) in self.entries.drain() {
-            release(ctx, bindless, data);
-        }
+    /// Empties the cache (at shutdown), handing every patch's data back.
+    pub fn drain(&mut self) -> Vec<D> {
+        self.entries.drain().map(|(_, e)| e.data).collect()
     }
 }
 
-/// Frees `data`'s bindless slots; its images are retired as it drops.
-fn release(ctx: &Context, bindless: &mut Bindless, data: PatchData) {
-    bindless.release(ctx, data.base_slot);
-    if let Some((_, slot)) = data.river {
-        bindless.release(ctx, slot);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn patch(level: u8, x: u32) -> PatchId {
+        PatchId {
+            face: 0,
+            level,
+            x,
+            y: 0,
+        }
+    }
+
+    #[test]
+    fn eviction_hands_back_the_least_recently_used_and_keeps_roots_and_this_frame() {
+        let mut cache = PatchCache::new(6);
+        cache.insert(patch(0, 0), "root");
+        cache.insert(patch(1, 0), "old");
+        cache.next_frame();
+        cache.insert(patch(1, 1), "newer");
+        cache.next_frame();
+        cache.insert(patch(2, 0), "current");
+        assert_eq!(cache.evict_to(2), vec!["old", "newer"]);
+        assert_eq!(cache.evict_to(0), Vec::<&str>::new());
+        assert_eq!(cache.len(), 2);
+        assert_eq!(
+            cache.nearest_resident(patch(2, 1)),
+            Some((patch(0, 0), &"root"))
+        );
+        assert_eq!(cache.resident_ancestor(patch(3, 0)), Some(patch(2, 0)));
     }
 }

@@ -1,30 +1,8 @@
 //! The range table of a dispatch (std430 rows the kernels read, glsl/river_kernel.glsl): which samples, output
 //! slot, reach masks and vertex lattice each row covers.
 
-use bytemuck::{Pod, Zeroable};
-
 use super::KernelBatch;
-
-/// One row of the range table (std430, 32 bytes): a patch, or for a patch that takes river data from its parent,
-/// one of its four vertex lattices (glsl/river_kernel.glsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuPatchJob {
-    pub spacing: f32,
-    pub sample_offset: u32,
-    pub sample_count: u32,
-    pub slot: u32,
-    /// Mask words of the rows before this one: the tiled kernel's reach masks of this row start there.
-    pub mask_offset: u32,
-    /// Stride (bits 0-7) and parity along x (bits 8-15) and y (bits 16-23) of the vertices this row covers.
-    pub lattice: u32,
-    /// The parent's slot to copy the row's vertices from, or [`NO_PARENT`].
-    pub parent_slot: u32,
-    /// The parent vertex of the row's first vertex: x (bits 0-15), y (bits 16-31).
-    pub parent_offset: u32,
-}
-
-const _: () = assert!(std::mem::size_of::<GpuPatchJob>() == 32);
+pub use crate::shader_types::GpuPatchJob;
 
 /// `parent_slot` of a row computed by the kernel.
 pub const NO_PARENT: u32 = u32::MAX;

@@ -7,8 +7,6 @@ mod batch;
 mod jobs;
 mod tuning;
 
-use bytemuck::{Pod, Zeroable};
-
 pub use self::{
     batch::{decode_texels, run_batch, run_batch_into, BatchOutputs, BatchResult},
     jobs::{range_table, GpuPatchJob, RangeTable, NO_PARENT},
@@ -22,6 +20,7 @@ use crate::{
         Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc,
         ImageUse, MemoryLocation, Recorder,
     },
+    shader_types::{KernelPush, TiledConstants},
     shaders,
 };
 
@@ -34,33 +33,8 @@ pub enum KernelVariant {
     Tiled,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct PushParams {
-    influence_distance: f32,
-    basin_depth: f32,
-    sea_level: f32,
-    basin_water_offset: f32,
-    grid_size: u32,
-    first_job: u32,
-}
-
-/// `KernelParams` in glsl/river_kernel.glsl.
-const _: () = assert!(std::mem::size_of::<PushParams>() == 24);
-
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
-/// The tiled kernel's specialization constants (glsl/kernel_tiled.comp, constant_id 0 to 4 in field order).
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct TiledConstants {
-    invocations: u32,
-    block_x: u32,
-    block_y: u32,
-    tile_size: u32,
-    subgroup_size: u32,
-}
-
 pub const RIVER_TEXTURE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 
@@ -100,7 +74,7 @@ impl RiverKernel {
         let tiled_inputs = BufferSetLayout::new(ctx, 3, "tiled river kernel inputs")?;
         let layouts = [bindless.layout, inputs.layout];
         let tiled_layouts = [bindless.layout, tiled_inputs.layout];
-        let push = std::mem::size_of::<PushParams>() as u32;
+        let push = std::mem::size_of::<KernelPush>() as u32;
         let simple = ComputePipeline::new(
             ctx,
             &ComputeDesc {
@@ -209,7 +183,7 @@ impl RiverKernel {
             (0, table.full_rows, [n, n]),
             (table.full_rows, rows.len() - table.full_rows, [half, half]),
         ];
-        let push = |first_job: usize| PushParams {
+        let push = |first_job: usize| KernelPush {
             influence_distance: params.influence_distance,
             basin_depth: params.basin_depth,
             sea_level: params.sea_level,
@@ -253,7 +227,7 @@ impl RiverKernel {
         [samples, table_buffer]: [&Buffer; 2],
         table: &RangeTable,
         groups: [(usize, usize, [u32; 2]); 2],
-        push: impl Fn(usize) -> PushParams,
+        push: impl Fn(usize) -> KernelPush,
     ) -> Result<u64, GpuError> {
         let [bx, by] = self.tuning.tiled_block;
         let masks = rec.ctx().create_buffer(&BufferDesc {

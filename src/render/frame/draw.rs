@@ -7,7 +7,7 @@ use std::{collections::HashMap, ops::Range};
 use glam::DVec3;
 
 use super::{
-    shader_data::{instance, PatchInstance, NO_MORPH},
+    shader_data::{instance, NO_MORPH},
     sky::Sky,
     vertex_cache::VertexCache,
     FrameStats, Renderer,
@@ -19,6 +19,7 @@ use crate::{
     },
     planet::cube::{PatchId, EDGES},
     runtime::{camera::Camera, lod::Selected},
+    shader_types::PatchInstance,
 };
 
 /// Every drawn terrain vertex of one frame, as the vertex shader placed it.

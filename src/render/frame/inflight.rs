@@ -75,7 +75,9 @@ impl Renderer<'_> {
         {
             if let Some(ranges) = payload.ranges {
                 for (patch, range) in ranges.read()? {
-                    self.cache.set_height_range(&patch, range);
+                    if let Some(data) = self.cache.get_mut(&patch) {
+                        data.height_range = range;
+                    }
                 }
             }
             if let Some(capture) = payload.drawn.read_capture(payload.camera, n) {

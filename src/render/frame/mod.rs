@@ -7,6 +7,7 @@ mod draw;
 mod inflight;
 mod modes;
 mod plan;
+mod resident;
 mod shader_data;
 mod sky;
 mod stats;
@@ -21,10 +22,10 @@ pub use self::draw::{DrawnVertex, VertexCapture};
 pub use self::inflight::GpuTimes;
 use self::inflight::{InFlight, TIMESTAMP_SCOPES};
 pub use self::modes::{ViewMode, WaterMode};
-use self::shader_data::FramePush;
-pub use self::shader_data::PatchInstance;
+use self::resident::PatchData;
 pub use self::stats::FrameStats;
 use super::mesh::{index_buffer, patch_mesh, PatchMesh, QuadrantMesh};
+use crate::shader_types::FramePush;
 use crate::{
     config::{Config, LodRule},
     gpu::{
@@ -89,7 +90,7 @@ pub struct Renderer<'w> {
     vertex_cache: vertex_cache::VertexCache,
     indices: Buffer,
     quadrants: [QuadrantMesh; 4],
-    cache: PatchCache,
+    cache: PatchCache<PatchData>,
     frames: FrameRing<InFlight>,
     /// GPU times of finished frames not yet taken (`take_gpu_times`), the newest 1024 at most.
     gpu_times: std::collections::VecDeque<GpuTimes>,
@@ -411,7 +412,7 @@ impl<'w> Renderer<'w> {
         stats.frames_in_flight = self.frames.in_flight(ctx)?;
         self.report_latest_gpu_times(&mut stats);
         stats.resident_patches = self.cache.len();
-        stats.patch_texture_bytes = self.cache.bytes();
+        stats.patch_texture_bytes = self.cache.values().map(PatchData::bytes).sum();
         stats.precomputed_height_bytes = self.planet.lattice.bytes();
         stats.memory_bytes = stats.patch_texture_bytes
             + stats.temporary_sample_bytes
@@ -439,6 +440,17 @@ impl<'w> Renderer<'w> {
         (&mut r.pixel_error, &mut r.level_of_detail_switch_factor)
     }
 
+    /// Evicts the least recently used patches beyond `target` (`PatchCache::evict_to`) and frees their slots;
+    /// returns how many.
+    fn evict_patches(&mut self, target: usize) -> usize {
+        let evicted = self.cache.evict_to(target);
+        let count = evicted.len();
+        for data in evicted {
+            data.release(self.ctx, &mut self.bindless);
+        }
+        count
+    }
+
     /// A free bindless slot, evicting the least recently used patches if none is left, and waiting for the frames
     /// in flight when the evicted slots are still theirs (only when the cache is full).
     fn slot(&mut self) -> Result<Slot, GpuError> {
@@ -446,8 +458,7 @@ impl<'w> Renderer<'w> {
         if let Some(s) = self.bindless.allocate(ctx) {
             return Ok(s);
         }
-        let capacity = self.cache.capacity;
-        self.cache.evict_to(capacity, ctx, &mut self.bindless);
+        self.evict_patches(self.cache.capacity);
         if let Some(s) = self.bindless.allocate(ctx) {
             return Ok(s);
         }
@@ -467,7 +478,9 @@ impl<'w> Renderer<'w> {
     pub fn destroy(mut self) {
         let ctx = self.ctx;
         let _ = ctx.wait_idle();
-        self.cache.clear(ctx, &mut self.bindless);
+        for data in self.cache.drain() {
+            data.release(ctx, &mut self.bindless);
+        }
         self.frames.destroy(ctx);
         self.kernel.destroy(ctx);
         self.refiner.destroy(ctx);

@@ -136,7 +136,6 @@ impl Renderer<'_> {
         visible: &[Selected],
         stats: &mut FrameStats,
     ) -> Result<Vec<PatchId>, GpuError> {
-        let ctx = self.ctx;
         let radius = self.planet.radius;
         // Patches without data: roots first (they stand in for everything), then coarse before fine and nearest
         // first, each after the ancestors it is refined from, within the per-frame budget; the rest draw an
@@ -182,9 +181,7 @@ impl Renderer<'_> {
             }
         }
         let requested = wanted.len();
-        stats.evicted_patches =
-            self.cache
-                .evict_to(self.cache.capacity - missing.len(), ctx, &mut self.bindless);
+        stats.evicted_patches = self.evict_patches(self.cache.capacity - missing.len());
         let room = self.cache.capacity.saturating_sub(self.cache.len());
         missing.truncate(room.max(forced));
         log::trace!(

@@ -1,47 +1,15 @@
-//! What crosses to the shaders each frame (std430 and push-constant mirrors of glsl/terrain_common.glsl, their
-//! sizes checked at compile time): the push constants every pass reads, and the instance of one drawn patch.
+//! What crosses to the shaders each frame, filled in: the push constants every pass reads and the instance of
+//! one drawn patch (their layouts in `shader_types`).
 
-use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3};
 
-use super::{Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT};
+use super::{resident::PatchData, Renderer, ViewMode, COLOUR_BAND_MOUNTAIN_HEIGHT};
 use crate::{
     planet::cube::{cube_point, PatchId, FACE_AXES},
     river::samples::PatchFrame,
-    runtime::{cache::PatchData, camera::Camera, lod::Selected},
+    runtime::{camera::Camera, lod::Selected},
+    shader_types::{FramePush, PatchInstance},
 };
-
-/// The push constants of every pass (`FramePush` in glsl/terrain_common.glsl); 128 bytes, what every Vulkan
-/// device holds.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub(super) struct FramePush {
-    view_projection: [[f32; 4]; 4],
-    sun: [f32; 4],
-    planet: [f32; 4],
-    extra: [f32; 4],
-    camera: [f32; 4],
-}
-
-const _: () = assert!(std::mem::size_of::<FramePush>() == 128);
-
-/// std430 mirror of `PatchInstance` in glsl/terrain_common.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct PatchInstance {
-    pub(super) centre_rel: [f32; 4],
-    pub(super) centre_dir: [f32; 4],
-    pub(super) cube_centre: [f32; 4],
-    pub(super) axis_u: [f32; 4],
-    pub(super) axis_v: [f32; 4],
-    pub(super) tex_rect: [f32; 4],
-    pub(super) slots: [i32; 4],
-    pub(super) morph: [f32; 4],
-    /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
-    pub(super) detail: [f32; 4],
-}
-
-const _: () = assert!(std::mem::size_of::<PatchInstance>() == 9 * 16);
 
 impl Renderer<'_> {
     /// This frame's push constants for `camera`.

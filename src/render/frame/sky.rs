@@ -1,7 +1,7 @@
 //! The atmosphere on the GPU (beyond the thesis; docs/rendering.md, "Atmosphere"): the transmittance table as a
 //! bindless texture that every pass reads, and the sky pass that draws the air where no surface is.
 
-use super::{FramePush, Renderer};
+use super::Renderer;
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
@@ -11,6 +11,7 @@ use crate::{
     },
     planet::atmosphere::Atmosphere,
     render::mesh::{dome_mesh, index_buffer},
+    shader_types::FramePush,
     shaders,
 };
 

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use super::Renderer;
+use super::{resident::PatchData, Renderer};
 use crate::{
     gpu::{bindless::Slot, Access, GpuError, Image, Recorder},
     kernel::{
@@ -16,7 +16,6 @@ use crate::{
     planet::{cube::PatchId, detail::PatchHeights},
     refine::{create_height_texture, prepare_height_textures, RefineJob, RefinedRanges},
     river::samples::{patch_samples, PatchFrame},
-    runtime::cache::PatchData,
 };
 
 /// A patch that gets its data this frame: base heights from the precomputed lattice (`None`: refined on the GPU
@@ -193,13 +192,14 @@ impl Renderer<'_> {
             let river = river.and_then(|k| rivers[k].take());
             self.cache.insert(
                 p.patch,
-                PatchData::new(
-                    (base, slot),
+                PatchData {
+                    base,
+                    base_slot: slot,
                     river,
-                    (p.samples.len(), p.final_detail),
-                    made[&p.patch].1,
-                    river_range(&p.samples, self.config.river.basin_depth),
-                ),
+                    river_final: p.final_detail,
+                    height_range: made[&p.patch].1,
+                    river_range: river_range(&p.samples, self.config.river.basin_depth),
+                },
             );
         }
         Ok(Uploaded {

@@ -13,7 +13,6 @@
 
 use std::mem::size_of;
 
-use super::FramePush;
 use crate::{
     gpu::{
         pipeline::{ComputeDesc, ComputePipeline},
@@ -21,6 +20,7 @@ use crate::{
         DrawIndexedIndirectCommand, GpuError, MemoryLocation, Recorder,
     },
     render::mesh::QuadrantMesh,
+    shader_types::FramePush,
     shaders,
 };
 

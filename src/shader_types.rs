@@ -1,0 +1,155 @@
+//! Every struct that crosses to the shaders, in one place, at the bottom of the layers (it depends on nothing of
+//! the project): std430 rows of storage buffers, push constants and specialization constants, each the mirror of
+//! a GLSL declaration named in its doc comment, its size and field offsets checked at compile time. The layers
+//! that fill them (model, kernel, refine, render) import them from here, so a producer never depends on its
+//! consumer for a type.
+
+use std::mem::{offset_of, size_of};
+
+use bytemuck::{Pod, Zeroable};
+
+/// One river sample (6.4): position and first derivative in the patch frame, river height and full width.
+/// Two vec4s in std430 (32 bytes), which lets the shaders load it with two aligned 16-byte reads
+/// (`RiverSample` in glsl/river_kernel.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RiverSample {
+    pub position: [f32; 2],
+    pub derivative: [f32; 2],
+    pub height: f32,
+    pub width: f32,
+    pub _pad: [f32; 2],
+}
+
+const _: () = assert!(size_of::<RiverSample>() == 32);
+const _: () = assert!(offset_of!(RiverSample, height) == 16);
+
+impl RiverSample {
+    pub fn new(position: [f32; 2], derivative: [f32; 2], height: f32, width: f32) -> Self {
+        Self {
+            position,
+            derivative,
+            height,
+            width,
+            _pad: [0.0; 2],
+        }
+    }
+}
+
+/// One row of the river kernel's range table (`PatchJob` in glsl/river_kernel.glsl): a patch, or for a patch
+/// that takes river data from its parent, one of its four vertex lattices (kernel/gpu/jobs.rs builds them).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuPatchJob {
+    pub spacing: f32,
+    pub sample_offset: u32,
+    pub sample_count: u32,
+    pub slot: u32,
+    /// Mask words of the rows before this one: the tiled kernel's reach masks of this row start there.
+    pub mask_offset: u32,
+    /// Stride (bits 0-7) and parity along x (bits 8-15) and y (bits 16-23) of the vertices this row covers.
+    pub lattice: u32,
+    /// The parent's slot to copy the row's vertices from, or `kernel::gpu::jobs::NO_PARENT`.
+    pub parent_slot: u32,
+    /// The parent vertex of the row's first vertex: x (bits 0-15), y (bits 16-31).
+    pub parent_offset: u32,
+}
+
+const _: () = assert!(size_of::<GpuPatchJob>() == 32);
+const _: () = assert!(offset_of!(GpuPatchJob, mask_offset) == 16);
+const _: () = assert!(offset_of!(GpuPatchJob, parent_offset) == 28);
+
+/// The river kernel's push constants (`KernelParams` in glsl/river_kernel.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct KernelPush {
+    pub influence_distance: f32,
+    pub basin_depth: f32,
+    pub sea_level: f32,
+    pub basin_water_offset: f32,
+    pub grid_size: u32,
+    pub first_job: u32,
+}
+
+const _: () = assert!(size_of::<KernelPush>() == 24);
+const _: () = assert!(offset_of!(KernelPush, grid_size) == 16);
+
+/// The tiled kernel's specialization constants (glsl/kernel_tiled.comp, constant_id 0 to 4 in field order).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TiledConstants {
+    pub invocations: u32,
+    pub block_x: u32,
+    pub block_y: u32,
+    pub tile_size: u32,
+    pub subgroup_size: u32,
+}
+
+const _: () = assert!(size_of::<TiledConstants>() == 20);
+
+/// One row of the height refiner's job table (`RefineJob` in glsl/heights_refine.comp).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuRefineJob {
+    pub child_slot: i32,
+    pub parent_slot: i32,
+    pub face: i32,
+    /// The child's level.
+    pub level: i32,
+    /// The child's position in its level's grid.
+    pub x: i32,
+    pub y: i32,
+    /// Where the child's lowest and highest height go in the ranges buffer.
+    pub range_index: i32,
+    pub unused: i32,
+}
+
+const _: () = assert!(size_of::<GpuRefineJob>() == 32);
+const _: () = assert!(offset_of!(GpuRefineJob, x) == 16);
+
+/// The height refiner's push constants (`Push` in glsl/heights_refine.comp).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct RefinePush {
+    pub seed: u32,
+    /// detail-amplitude: the displacement of level 0.
+    pub amplitude: f32,
+}
+
+const _: () = assert!(size_of::<RefinePush>() == 8);
+
+/// The push constants of every pass of a frame (`FramePush` in glsl/terrain_common.glsl, whose comments say
+/// what each component holds); 128 bytes, what every Vulkan device holds.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FramePush {
+    pub view_projection: [[f32; 4]; 4],
+    pub sun: [f32; 4],
+    pub planet: [f32; 4],
+    pub extra: [f32; 4],
+    pub camera: [f32; 4],
+}
+
+const _: () = assert!(size_of::<FramePush>() == 128);
+const _: () = assert!(offset_of!(FramePush, sun) == 64);
+const _: () = assert!(offset_of!(FramePush, camera) == 112);
+
+/// One drawn patch (`PatchInstance` in glsl/terrain_common.glsl, whose comments say what each component holds).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PatchInstance {
+    pub centre_rel: [f32; 4],
+    pub centre_dir: [f32; 4],
+    pub cube_centre: [f32; 4],
+    pub axis_u: [f32; 4],
+    pub axis_v: [f32; 4],
+    pub tex_rect: [f32; 4],
+    pub slots: [i32; 4],
+    pub morph: [f32; 4],
+    /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
+    pub detail: [f32; 4],
+}
+
+const _: () = assert!(size_of::<PatchInstance>() == 9 * 16);
+const _: () = assert!(offset_of!(PatchInstance, slots) == 6 * 16);
+const _: () = assert!(offset_of!(PatchInstance, detail) == 8 * 16);
