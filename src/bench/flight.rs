@@ -2,7 +2,7 @@
 //! times, GPU pass times and memory (Figures 9.1-9.8); every frame's new river patches also run through all four
 //! kernel variants so they compare like for like; and the same flight in each water mode.
 
-use std::collections::BTreeMap;
+use std::{cell::RefCell, collections::BTreeMap, rc::Rc};
 
 use serde::Serialize;
 
@@ -15,13 +15,16 @@ use super::{
 use crate::{
     config::Config,
     gpu::{Access, Context, GpuError},
-    kernel::{gpu::KernelTuning, KernelParams, PatchJob},
+    kernel::{gpu::KernelTuning, KernelParams, PatchJob, RiverSample},
     render::{
         target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
         FrameStats, GpuTimes, Renderer, WaterMode,
     },
     world::World,
 };
+
+/// One frame's kernel input, owned: (vertex spacing, samples) per new patch with rivers.
+type KernelInput = Vec<(f32, Vec<RiverSample>)>;
 
 /// The four kernel variants on one frame's new river patches (ms).
 #[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
@@ -198,7 +201,17 @@ fn fly(
     if let Some(rule) = options.lod_rule {
         renderer.lod_rule = rule;
     }
-    renderer.capture_batches = runner.is_some();
+    // Each frame's kernel input, to rerun through every variant.
+    let kernel_input: Rc<RefCell<KernelInput>> = Rc::default();
+    if runner.is_some() {
+        let sink = Rc::clone(&kernel_input);
+        renderer.observe_kernel_input(Box::new(move |jobs| {
+            *sink.borrow_mut() = jobs
+                .iter()
+                .map(|j| (j.spacing, j.samples.to_vec()))
+                .collect();
+        }));
+    }
     let params = KernelParams::from_config(config);
     let speed = if options.stress { 25.0 } else { options.speed };
     let aspect = w as f64 / h as f64;
@@ -233,16 +246,17 @@ fn fly(
                 &[],
                 &[],
             )?;
-            let compare = runner.is_some() && !renderer.last_batch.is_empty();
+            let input = kernel_input.take();
+            let compare = runner.is_some() && !input.is_empty();
             let check_holes = options.descent && frame % HOLE_CHECK_EVERY == 0;
             if compare || check_holes {
                 // The benchmark's own work waits for the GPU; the wait for this frame is the frame's.
                 renderer.finish()?;
                 stats.frame_ms = start.elapsed().as_secs_f64() * 1e3;
             }
-            let kernels = match (&mut runner, renderer.last_batch.is_empty()) {
+            let kernels = match (&mut runner, input.is_empty()) {
                 (Some(runner), false) => {
-                    let jobs = PatchJob::from_pairs(&renderer.last_batch);
+                    let jobs = PatchJob::from_pairs(&input);
                     let (v, _, _) = runner.measure(ctx, &jobs, &params, 1, false)?;
                     Some(FrameKernels {
                         cpu_single_ms: v.cpu_single.kernel_ms,

@@ -36,7 +36,7 @@ use crate::{
     },
     kernel::{
         gpu::{KernelTuning, KernelVariant, RiverKernel},
-        KernelParams, RiverSample,
+        KernelParams, PatchJob,
     },
     planet::{atmosphere::Atmosphere, Planet},
     refine::HeightRefiner,
@@ -49,6 +49,10 @@ use crate::{
     },
     shaders,
 };
+
+/// Called with a frame's kernel input (the new patches with rivers: vertex spacing and samples) before the kernel
+/// is recorded: for benchmarks that rerun it through every kernel variant.
+pub type KernelObserver<'w> = Box<dyn FnMut(&[PatchJob]) + 'w>;
 
 /// Draws recorded into a frame's rendering after its own passes (the viewer's overlay).
 pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, Extent2D);
@@ -134,10 +138,8 @@ pub struct Renderer<'w> {
     pub lod_rule: LodRule,
     /// Unit direction towards the sun; `None`: over the camera's shoulder.
     pub sun: Option<DVec3>,
-    /// Keep each frame's kernel input in `last_batch` (for benchmarks that rerun it through every variant).
-    pub capture_batches: bool,
-    /// The last frame's new river patches: (vertex spacing, samples).
-    pub last_batch: Vec<(f32, Vec<RiverSample>)>,
+    /// Handed each frame's kernel input before it is recorded (`observe_kernel_input`).
+    kernel_observer: Option<KernelObserver<'w>>,
     /// Record where the terrain pass put every vertex in `last_capture` (tests of precision and morphing).
     pub capture_vertices: bool,
     pub last_capture: Option<VertexCapture>,
@@ -300,8 +302,7 @@ impl<'w> Renderer<'w> {
             morphing: true,
             parent_reuse: true,
             sun: None,
-            capture_batches: false,
-            last_batch: Vec::new(),
+            kernel_observer: None,
             capture_vertices: false,
             last_capture: None,
         })
@@ -438,6 +439,11 @@ impl<'w> Renderer<'w> {
     pub fn level_of_detail_settings(&mut self) -> (&mut f32, &mut f32) {
         let r = &mut self.config.rendering;
         (&mut r.pixel_error, &mut r.level_of_detail_switch_factor)
+    }
+
+    /// Hands every later frame's kernel input to `observer` (none for frames that compute no river data).
+    pub fn observe_kernel_input(&mut self, observer: KernelObserver<'w>) {
+        self.kernel_observer = Some(observer);
     }
 
     /// Evicts the least recently used patches beyond `target` (`PatchCache::evict_to`) and frees their slots;

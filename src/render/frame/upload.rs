@@ -70,7 +70,6 @@ impl Renderer<'_> {
         rec: &mut Recorder,
         prepared: &[NewPatch],
     ) -> Result<Uploaded, GpuError> {
-        self.last_batch.clear();
         if prepared.is_empty() {
             return Ok(Uploaded {
                 bytes: 0,
@@ -81,18 +80,6 @@ impl Renderer<'_> {
         }
         let ctx = self.ctx;
         let n = self.config.rendering.vertices;
-        if self.capture_batches {
-            self.last_batch = prepared
-                .iter()
-                .filter(|p| !p.samples.is_empty())
-                .map(|p| {
-                    (
-                        PatchFrame::new(p.patch, self.planet.radius, n).spacing() as f32,
-                        p.samples.clone(),
-                    )
-                })
-                .collect();
-        }
         let mut bases: Vec<(Image, Slot)> = Vec::with_capacity(prepared.len());
         for p in prepared {
             let image = create_height_texture(ctx, n, &format!("base heights {:?}", p.patch))?;
@@ -171,6 +158,9 @@ impl Renderer<'_> {
             rivers.push((image, slot));
         }
         let slots: Vec<Slot> = rivers.iter().map(|(_, s)| *s).collect();
+        if let (false, Some(observe)) = (patch_jobs.is_empty(), &mut self.kernel_observer) {
+            observe(&patch_jobs);
+        }
         if !rivers.is_empty() {
             let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
             let batch = KernelBatch {
