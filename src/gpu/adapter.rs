@@ -136,16 +136,16 @@ pub fn enumerate(options: &ContextOptions) -> Result<(String, Vec<AdapterInfo>),
 
 /// A warning for a driver setting known to break this renderer: lavapipe (llvmpipe) told to use vectors narrower
 /// than 256 bits (`LP_NATIVE_VECTOR_WIDTH`, set in `width`; what it picks by itself on CPUs without AVX2) corrupts
-/// its heap in the terrain pass (docs/rendering.md, "Vertex capture"; issue 16), so the crash that follows is
-/// explained first.
+/// its heap drawing the terrain and the water (docs/rendering.md, "Vertex capture"; issue 16), so the crash that
+/// follows is explained first.
 pub(super) fn driver_warning(adapter: &AdapterInfo, width: Option<&str>) -> Option<String> {
     let narrow = width
         .and_then(|w| w.trim().parse::<u32>().ok())
         .is_some_and(|w| w < 256);
     (adapter.driver_name == "llvmpipe" && narrow).then(|| {
         format!(
-            "LP_NATIVE_VECTOR_WIDTH={}: lavapipe with vectors narrower than 256 bits corrupts its heap in the \
-             terrain pass and aborts on the first frame (docs/rendering.md, \"Vertex capture\"); unset it",
+            "LP_NATIVE_VECTOR_WIDTH={}: lavapipe with vectors narrower than 256 bits corrupts its heap drawing \
+             the terrain and the water and aborts on the first frame (docs/rendering.md, \"Vertex capture\"); unset it",
             width.unwrap_or_default().trim()
         )
     })
