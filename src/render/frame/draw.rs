@@ -280,10 +280,7 @@ impl Renderer<'_> {
         let water_draws = VertexCache::water_draws(ctx, cached, &self.quadrants)?;
         let water_indices = VertexCache::water_indices(ctx, cached, n)?;
         let draw_sky = self.sky().is_some();
-        let dome_vertices = match draw_sky {
-            true => Some(Sky::dome_vertices(ctx)?),
-            false => None,
-        };
+        let dome_vertices = draw_sky.then(|| Sky::dome_vertices(ctx)).transpose()?;
         let instance_set = rec.buffer_set(
             &self.instance_layout,
             &[
