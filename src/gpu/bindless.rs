@@ -105,6 +105,7 @@ impl Bindless {
         let set = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .vk("vkAllocateDescriptorSets")?[0];
         ctx.set_name(set, SET_NAME);
+        ctx.register_runtime_array_set(set);
         let sampler_info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::LINEAR)
             .min_filter(vk::Filter::LINEAR)

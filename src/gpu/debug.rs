@@ -19,14 +19,22 @@ pub(super) struct ValidationLog {
     /// Synchronization hazards reported through the bindless set's runtime arrays, which are not counted as errors
     /// (`is_runtime_array_hazard`).
     waived: std::sync::atomic::AtomicUsize,
+    /// The raw handles of the bindless sets: a message names the set by handle even where the layer has lost its
+    /// name (seen with two renderers on one device in concurrent tests).
+    runtime_array_sets: Mutex<Vec<u64>>,
 }
 
 /// Whether `message` is a synchronization hazard that validation layers before 1.3.268 report for every element of
 /// a runtime descriptor array the pipeline declares, accessed or not (Vulkan-ValidationLayers issue 3450): every
 /// dispatch and draw that binds the bindless set would "write" every patch texture. Later layers skip runtime
 /// arrays in synchronization validation altogether (pull request 6605), so waiving them checks what they check.
-fn is_runtime_array_hazard(message: &str) -> bool {
-    message.contains("SYNC-HAZARD") && message.contains(&format!("[{}]", super::bindless::SET_NAME))
+/// The set is recognised by its name or by one of `sets`' raw handles.
+fn is_runtime_array_hazard(message: &str, sets: &[u64]) -> bool {
+    message.contains("SYNC-HAZARD")
+        && (message.contains(&format!("[{}]", super::bindless::SET_NAME))
+            || sets
+                .iter()
+                .any(|h| message.contains(&format!("VkDescriptorSet 0x{h:x}["))))
 }
 
 unsafe extern "system" fn debug_callback(
@@ -45,7 +53,10 @@ unsafe extern "system" fn debug_callback(
         // SAFETY: `user` is the boxed ValidationLog owned by the Context, alive until the messenger is destroyed.
         let validation_log = unsafe { (user as *const ValidationLog).as_ref() };
         if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-            if is_runtime_array_hazard(&message) {
+            let sets = validation_log
+                .and_then(|log| log.runtime_array_sets.lock().ok().map(|s| s.clone()))
+                .unwrap_or_default();
+            if is_runtime_array_hazard(&message, &sets) {
                 log::debug!("[vulkan {kind:?}] waived (runtime descriptor array): {message}");
                 if let Some(log) = validation_log {
                     log.waived
@@ -100,6 +111,13 @@ impl Context {
         self.validation_enabled
     }
 
+    /// Registers a bindless set, whose runtime arrays' synchronization hazards are waived (`is_runtime_array_hazard`).
+    pub(crate) fn register_runtime_array_set(&self, set: vk::DescriptorSet) {
+        if let Ok(mut sets) = self.validation_log.runtime_array_sets.lock() {
+            sets.push(vk::Handle::as_raw(set));
+        }
+    }
+
     /// Synchronization hazards waived so far because they were reported through the bindless set's runtime arrays
     /// (`is_runtime_array_hazard`).
     pub fn waived_validation_messages(&self) -> usize {
@@ -150,5 +168,25 @@ impl Context {
             // SAFETY: paired with begin_label on a recording command buffer.
             unsafe { debug.cmd_end_debug_utils_label(cmd) };
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runtime_array_hazards_are_recognised_by_the_set_name_or_its_handle() {
+        let named = "Validation Error: [ SYNC-HAZARD-WRITE-AFTER-WRITE ] ... VkDescriptorSet 0x11[bindless set], \
+                     type: VK_DESCRIPTOR_TYPE_STORAGE_IMAGE";
+        let unnamed = "Validation Error: [ SYNC-HAZARD-WRITE-AFTER-WRITE ] ... VkDescriptorSet 0x110000000011[], \
+                       type: VK_DESCRIPTOR_TYPE_STORAGE_IMAGE";
+        assert!(is_runtime_array_hazard(named, &[]));
+        assert!(!is_runtime_array_hazard(unnamed, &[]));
+        assert!(is_runtime_array_hazard(unnamed, &[0x110000000011]));
+        assert!(!is_runtime_array_hazard(unnamed, &[0x11]));
+        let other =
+            "Validation Error: [ VUID-vkCmdDraw-None-02699 ] VkDescriptorSet 0x110000000011[]";
+        assert!(!is_runtime_array_hazard(other, &[0x110000000011]));
     }
 }
