@@ -341,6 +341,57 @@ fn an_adapter_that_matches_no_device_is_named_not_a_crash() {
     );
 }
 
+/// Finding 5 of issue 16: lavapipe at 128 bits corrupts its heap drawing the terrain (a Mesa fault,
+/// docs/rendering.md). The drawing commands refuse it by name before any work, with no file written; compute-only
+/// commands still run.
+#[test]
+fn lavapipe_with_narrow_vectors_is_refused_for_drawing_not_crashed_on() {
+    let dir = temp_dir("narrow");
+    let out = dir.join("x.png");
+    let narrow = |args: &[&str]| {
+        riverplanet()
+            .env("LP_NATIVE_VECTOR_WIDTH", "128")
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out_arg = out.to_str().unwrap();
+    let render = narrow(&["render", "--seed", "1", "--size", "32x18", "--out", out_arg]);
+    assert_refused(
+        &render,
+        1,
+        &["128-bit", "LP_NATIVE_VECTOR_WIDTH", "cannot draw"],
+    );
+    assert!(!out.exists(), "render left {}", out.display());
+    let json = dir.join("flight.json");
+    let flight = narrow(&[
+        "bench",
+        "flight",
+        "--frames",
+        "2",
+        "--size",
+        "32x18",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_refused(&flight, 1, &["128-bit", "cannot draw"]);
+    assert!(!json.exists());
+    let kernel = narrow(&[
+        "bench",
+        "kernel",
+        "--frames",
+        "2",
+        "--json",
+        dir.join("k.json").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        kernel.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&kernel.stderr)
+    );
+}
+
 #[test]
 fn bad_output_paths_are_refused_before_any_work_and_nothing_is_overwritten() {
     let dir = temp_dir("outputs");

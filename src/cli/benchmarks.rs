@@ -120,8 +120,12 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 })
                 .transpose()?;
             let frames = path.as_ref().map_or(frames, |p| p.frames.len() as u32);
+            // Before any work: a device that cannot draw is refused here.
+            let ctx = Context::new(&ContextOptions {
+                draws: true,
+                ..options.clone()
+            })?;
             let world = riverplanet::world::World::build(&config, planet.seed)?;
-            let ctx = Context::new(options)?;
             let bar = std::io::stderr()
                 .is_terminal()
                 .then(|| indicatif::ProgressBar::new(frames as u64));

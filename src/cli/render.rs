@@ -29,6 +29,11 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
             args.fov
         )));
     }
+    // Before any work: a device that cannot draw is refused here.
+    let ctx = Context::new(&ContextOptions {
+        draws: true,
+        ..options.clone()
+    })?;
     let seed = planet_seed(args.planet.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match (args.preset, &recorded) {
@@ -47,7 +52,6 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         "camera: --eye {},{},{} --look-at {},{},{}",
         eye.x, eye.y, eye.z, look_at.x, look_at.y, look_at.z
     );
-    let ctx = Context::new(options)?;
     let [w, h] = args.size;
     let target = riverplanet::render::target::Offscreen::new(&ctx, w, h)?;
     let mut renderer = riverplanet::render::Renderer::new(

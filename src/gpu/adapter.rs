@@ -134,30 +134,38 @@ pub fn enumerate(options: &ContextOptions) -> Result<(String, Vec<AdapterInfo>),
     Ok((version, result?))
 }
 
-/// A warning for a driver setting known to break this renderer: lavapipe (llvmpipe) told to use vectors narrower
-/// than 256 bits (`LP_NATIVE_VECTOR_WIDTH`, set in `width`; what it picks by itself on CPUs without AVX2) corrupts
-/// its heap drawing the terrain and the water (docs/rendering.md, "Vertex capture"; issue 16), so the crash that
-/// follows is explained first.
-pub(super) fn driver_warning(adapter: &AdapterInfo, width: Option<&str>) -> Option<String> {
-    let narrow = width
-        .and_then(|w| w.trim().parse::<u32>().ok())
-        .is_some_and(|w| w < 256);
-    (adapter.driver_name == "llvmpipe" && narrow).then(|| {
-        format!(
-            "LP_NATIVE_VECTOR_WIDTH={}: lavapipe with vectors narrower than 256 bits corrupts its heap drawing \
-             the terrain and the water and aborts on the first frame (docs/rendering.md, \"Vertex capture\"); unset it",
-            width.unwrap_or_default().trim()
-        )
-    })
+/// The vector width lavapipe (llvmpipe) compiles shaders for, from its device name ("llvmpipe (LLVM 15.0.6, 256
+/// bits)"): `LP_NATIVE_VECTOR_WIDTH` where set, else what the CPU offers (128 without AVX2).
+fn lavapipe_vector_bits(adapter: &AdapterInfo) -> Option<u32> {
+    if adapter.driver_name != "llvmpipe" {
+        return None;
+    }
+    let (before, _) = adapter.name.split_once(" bits")?;
+    before.rsplit([' ', ',']).next()?.parse().ok()
+}
+
+/// Why `adapter` cannot draw this renderer, if it cannot: lavapipe with vectors narrower than 256 bits corrupts
+/// its heap drawing the terrain and the water and aborts on the first frame (a Mesa fault, docs/rendering.md,
+/// "Vertex capture"; issue 16). Its compute paths work, so only contexts that draw refuse it.
+pub(super) fn cannot_draw(adapter: &AdapterInfo) -> Option<String> {
+    lavapipe_vector_bits(adapter)
+        .filter(|&bits| bits < 256)
+        .map(|bits| {
+            format!(
+                "lavapipe with {bits}-bit vectors corrupts its heap drawing the terrain (a Mesa fault, \
+                 docs/rendering.md, \"Vertex capture\"); unset LP_NATIVE_VECTOR_WIDTH, or on a CPU without AVX2 use \
+                 another driver; compute-only commands (bench kernel, generate, export) still run"
+            )
+        })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn adapter(driver_name: &str) -> AdapterInfo {
+    fn adapter(driver_name: &str, name: &str) -> AdapterInfo {
         AdapterInfo {
-            name: "test".into(),
+            name: name.into(),
             device_type: "CPU".into(),
             api_version: "1.3.0".into(),
             driver_name: driver_name.into(),
@@ -168,11 +176,16 @@ mod tests {
     }
 
     #[test]
-    fn narrow_lavapipe_vectors_are_warned_about_and_nothing_else() {
-        let warning = driver_warning(&adapter("llvmpipe"), Some("128")).unwrap();
-        assert!(warning.contains("LP_NATIVE_VECTOR_WIDTH=128"), "{warning}");
-        assert!(driver_warning(&adapter("llvmpipe"), Some("256")).is_none());
-        assert!(driver_warning(&adapter("llvmpipe"), None).is_none());
-        assert!(driver_warning(&adapter("NVIDIA"), Some("128")).is_none());
+    fn lavapipe_with_narrow_vectors_cannot_draw_and_nothing_else_is_refused() {
+        let narrow = adapter("llvmpipe", "llvmpipe (LLVM 15.0.6, 128 bits)");
+        let reason = cannot_draw(&narrow).unwrap();
+        assert!(
+            reason.contains("128-bit") && reason.contains("LP_NATIVE_VECTOR_WIDTH"),
+            "{reason}"
+        );
+        assert!(cannot_draw(&adapter("llvmpipe", "llvmpipe (LLVM 15.0.6, 256 bits)")).is_none());
+        assert!(cannot_draw(&adapter("llvmpipe", "llvmpipe (LLVM 15.0.6, 512 bits)")).is_none());
+        assert!(cannot_draw(&adapter("llvmpipe", "llvmpipe")).is_none());
+        assert!(cannot_draw(&adapter("NVIDIA", "NVIDIA H200 (128 bits)")).is_none());
     }
 }

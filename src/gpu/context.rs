@@ -28,6 +28,9 @@ pub struct ContextOptions {
     pub instance_extensions: Vec<&'static CStr>,
     /// Enable `VK_KHR_swapchain` on the device.
     pub swapchain: bool,
+    /// The context will draw (not only compute): a device known to break drawing is refused
+    /// (`adapter::cannot_draw`) before any work.
+    pub draws: bool,
 }
 
 impl ContextOptions {
@@ -192,6 +195,12 @@ impl Context {
                 missing: adapter.features.missing().join(", "),
             });
         }
+        if let (true, Some(reason)) = (options.draws, super::adapter::cannot_draw(&adapter)) {
+            return Err(GpuError::CannotDraw {
+                device: adapter.name.clone(),
+                reason,
+            });
+        }
         let physical = physicals[idx];
         let queue_family =
             graphics_compute_family(&instance, physical).ok_or(GpuError::NoDevice)?;
@@ -255,12 +264,6 @@ impl Context {
         let timeline = Timeline::new(&device)?;
         let debug_device =
             validation_enabled.then(|| ext::debug_utils::Device::new(&instance, &device));
-        if let Some(warning) = super::adapter::driver_warning(
-            &adapter,
-            std::env::var("LP_NATIVE_VECTOR_WIDTH").ok().as_deref(),
-        ) {
-            log::warn!("{warning}");
-        }
         log::info!(
             "using '{}' (validation {})",
             adapter.name,

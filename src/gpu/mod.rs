@@ -56,6 +56,8 @@ pub enum GpuError {
     NoMatchingAdapter { filter: String, available: String },
     #[error("device '{device}' lacks required Vulkan feature(s): {missing}")]
     MissingFeature { device: String, missing: String },
+    #[error("device '{device}' cannot draw this renderer: {reason}")]
+    CannotDraw { device: String, reason: String },
     #[error("GPU memory allocation for '{name}' failed: {source}")]
     Allocation {
         name: String,

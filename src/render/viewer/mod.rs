@@ -98,6 +98,7 @@ pub fn run(
     let mut ctx_options = context_options.clone();
     ctx_options.instance_extensions = swapchain::surface_extensions(display)?;
     ctx_options.swapchain = true;
+    ctx_options.draws = true;
     let ctx = Context::new(&ctx_options)?;
     let renderer = Renderer::new(
         &ctx,
