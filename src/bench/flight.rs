@@ -365,26 +365,22 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
     ] {
         kernel_average_ms.insert(name.to_string(), mean(kernel_frames.iter().map(|k| get(k))));
     }
-    let mut kernel_ratios = BTreeMap::new();
     let avg = |k: &str| kernel_average_ms.get(k).copied().unwrap_or(0.0);
-    if !kernel_frames.is_empty() {
-        kernel_ratios.insert(
-            "tiled_over_simple".into(),
-            avg("gpu_tiled") / avg("gpu_simple"),
-        );
-        kernel_ratios.insert(
-            "cpu_single_over_gpu_tiled".into(),
-            avg("cpu_single") / avg("gpu_tiled"),
-        );
-        kernel_ratios.insert(
-            "cpu_single_over_gpu_tiled_end_to_end".into(),
-            avg("cpu_single") / avg("gpu_tiled_end_to_end"),
-        );
-        kernel_ratios.insert(
-            "cpu_single_over_cpu_rayon".into(),
-            avg("cpu_single") / avg("cpu_rayon"),
-        );
-    }
+    // Each ratio of two variants' averages, named after them.
+    let kernel_ratios: BTreeMap<String, f64> = [
+        ("tiled_over_simple", "gpu_tiled", "gpu_simple"),
+        ("cpu_single_over_gpu_tiled", "cpu_single", "gpu_tiled"),
+        (
+            "cpu_single_over_gpu_tiled_end_to_end",
+            "cpu_single",
+            "gpu_tiled_end_to_end",
+        ),
+        ("cpu_single_over_cpu_rayon", "cpu_single", "cpu_rayon"),
+    ]
+    .into_iter()
+    .filter(|_| !kernel_frames.is_empty())
+    .map(|(name, over, under)| (name.to_string(), avg(over) / avg(under)))
+    .collect();
     let max_memory_bytes = stats.iter().map(|s| s.memory_bytes).max().unwrap_or(0);
     FlightSummary {
         frames: frames.len(),
