@@ -376,6 +376,9 @@ fn lavapipe_with_narrow_vectors_is_refused_for_drawing_not_crashed_on() {
     ]);
     assert_refused(&flight, 1, &["128-bit", "cannot draw"]);
     assert!(!json.exists());
+    // Before any window (none is needed to be refused).
+    let view = narrow(&["view", "--seed", "1", "--frames", "1"]);
+    assert_refused(&view, 1, &["128-bit", "cannot draw"]);
     let kernel = narrow(&[
         "bench",
         "kernel",

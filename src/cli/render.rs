@@ -174,6 +174,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
     if let Some(eye) = args.eye {
         check_camera(eye, args.look_at, &config)?;
     }
+    riverplanet::gpu::adapter::check_can_draw(options)?;
     let seed = planet_seed(args.planet.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.eye {

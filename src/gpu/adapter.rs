@@ -144,6 +144,22 @@ fn lavapipe_vector_bits(adapter: &AdapterInfo) -> Option<u32> {
     before.rsplit([' ', ',']).next()?.parse().ok()
 }
 
+/// Refuses, before any work, the device a drawing context would choose if it cannot draw (`cannot_draw`), for
+/// commands that build a planet before they create their context (the viewer).
+pub fn check_can_draw(options: &ContextOptions) -> Result<(), GpuError> {
+    let (_, adapters) = enumerate(options)?;
+    match adapters.iter().find(|a| a.chosen) {
+        Some(adapter) => match cannot_draw(adapter) {
+            Some(reason) => Err(GpuError::CannotDraw {
+                device: adapter.name.clone(),
+                reason,
+            }),
+            None => Ok(()),
+        },
+        None => Ok(()),
+    }
+}
+
 /// Why `adapter` cannot draw this renderer, if it cannot: lavapipe with vectors narrower than 256 bits corrupts
 /// its heap drawing the terrain and the water and aborts on the first frame (a Mesa fault, docs/rendering.md,
 /// "Vertex capture"; issue 16). Its compute paths work, so only contexts that draw refuse it.
