@@ -165,8 +165,14 @@ fn info(options: &ContextOptions, json: bool) -> ExitCode {
     let usable = adapters
         .iter()
         .any(|a| a.chosen && a.features.all_supported());
+    // Why the chosen device cannot draw (it may still compute).
+    let cannot_draw = adapters
+        .iter()
+        .find(|a| a.chosen)
+        .and_then(gpu::adapter::cannot_draw);
     if json {
-        let value = serde_json::json!({ "instance_version": version, "devices": adapters, "usable": usable });
+        let value = serde_json::json!({ "instance_version": version, "devices": adapters, "usable": usable,
+            "draws": usable && cannot_draw.is_none(), "cannot_draw": cannot_draw });
         println!(
             "{}",
             serde_json::to_string_pretty(&value).unwrap_or_default()
@@ -193,6 +199,9 @@ fn info(options: &ContextOptions, json: bool) -> ExitCode {
                     if c.supported { "yes" } else { "NO" }
                 );
             }
+        }
+        if let Some(reason) = &cannot_draw {
+            println!("the chosen device cannot draw: {reason}");
         }
     }
     if usable {

@@ -379,6 +379,13 @@ fn lavapipe_with_narrow_vectors_is_refused_for_drawing_not_crashed_on() {
     // Before any window (none is needed to be refused).
     let view = narrow(&["view", "--seed", "1", "--frames", "1"]);
     assert_refused(&view, 1, &["128-bit", "cannot draw"]);
+    let info = narrow(&["info", "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(info["draws"], false, "{info}");
+    assert!(
+        info["cannot_draw"].as_str().unwrap().contains("128-bit"),
+        "{info}"
+    );
     let kernel = narrow(&[
         "bench",
         "kernel",

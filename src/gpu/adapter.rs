@@ -163,7 +163,7 @@ pub fn check_can_draw(options: &ContextOptions) -> Result<(), GpuError> {
 /// Why `adapter` cannot draw this renderer, if it cannot: lavapipe with vectors narrower than 256 bits corrupts
 /// its heap drawing the terrain and the water and aborts on the first frame (a Mesa fault, docs/rendering.md,
 /// "Vertex capture"; issue 16). Its compute paths work, so only contexts that draw refuse it.
-pub(super) fn cannot_draw(adapter: &AdapterInfo) -> Option<String> {
+pub fn cannot_draw(adapter: &AdapterInfo) -> Option<String> {
     lavapipe_vector_bits(adapter)
         .filter(|&bits| bits < 256)
         .map(|bits| {
