@@ -1,11 +1,11 @@
 //! The atmosphere on the GPU (beyond the thesis; docs/rendering.md, "Atmosphere"): the transmittance table as a
 //! bindless texture that every pass reads, and the sky pass that draws the air where no surface is.
 
-use super::Renderer;
+use super::{vertex_cache::frame_compute, Renderer};
 use crate::{
     gpu::{
         bindless::{Bindless, Slot},
-        pipeline::{Blend, ComputeDesc, ComputePipeline, GraphicsDesc, GraphicsPipeline},
+        pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline},
         Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, Extent2D, Format,
         GpuError, Image, ImageDesc, ImageUse, MemoryLocation, Recorder,
     },
@@ -87,16 +87,12 @@ impl Sky {
             GpuError::Invalid("no bindless slot left for the atmosphere".to_string())
         })?;
         bindless.write(ctx, slot, &image, false);
-        let dome_pipeline = ComputePipeline::new(
+        let dome_pipeline = frame_compute(
             ctx,
-            &ComputeDesc {
-                name: "sky dome",
-                spirv: shaders::SKY_DOME_COMP,
-                set_layouts,
-                push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                specialization: bytemuck::bytes_of(&[RINGS, SEGMENTS]),
-                full_subgroups: None,
-            },
+            set_layouts,
+            "sky dome",
+            shaders::SKY_DOME_COMP,
+            bytemuck::bytes_of(&[RINGS, SEGMENTS]),
         )?;
         // The dome lies at depth 0: only pixels no surface covered pass the depth test.
         let pipeline = GraphicsPipeline::new(

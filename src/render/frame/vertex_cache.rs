@@ -41,19 +41,7 @@ pub(super) struct VertexCache {
 
 impl VertexCache {
     pub(super) fn new(ctx: &Context, layouts: &[DescriptorSetLayout]) -> Result<Self, GpuError> {
-        let pipeline = |name, spirv| {
-            ComputePipeline::new(
-                ctx,
-                &ComputeDesc {
-                    name,
-                    spirv,
-                    set_layouts: layouts,
-                    push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                    specialization: &[],
-                    full_subgroups: None,
-                },
-            )
-        };
+        let pipeline = |name, spirv| frame_compute(ctx, layouts, name, spirv, &[]);
         Ok(Self {
             pipeline: pipeline("vertex cache", shaders::VERTEX_CACHE_COMP)?,
             water_triangles: pipeline("water triangles", shaders::WATER_TRIANGLES_COMP)?,
@@ -154,4 +142,26 @@ impl VertexCache {
         self.pipeline.destroy(ctx);
         self.water_triangles.destroy(ctx);
     }
+}
+
+/// A compute pipeline of the frame: it binds the frame's sets (`layouts`) and reads its push constants
+/// (`FramePush`), as the vertex cache's passes and the sky dome do.
+pub(super) fn frame_compute(
+    ctx: &Context,
+    layouts: &[DescriptorSetLayout],
+    name: &str,
+    spirv: &[u8],
+    specialization: &[u8],
+) -> Result<ComputePipeline, GpuError> {
+    ComputePipeline::new(
+        ctx,
+        &ComputeDesc {
+            name,
+            spirv,
+            set_layouts: layouts,
+            push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
+            specialization,
+            full_subgroups: None,
+        },
+    )
 }
