@@ -181,6 +181,25 @@ vec3 rippleSpace(bool river, out float visible) {
     return q;
 }
 
+// How fast the interpolated signed distance to the nearest river changes along the surface, per unit of length.
+// A distance changes at most as fast as one moves, so where a triangle's vertices measure the same river it is
+// at most sqrt(2) (a right triangle's interpolant of a 1-Lipschitz field). Where they measure different rivers, or
+// one measures none (the influence distance's default) or sits beyond a river's end (the sign flips there), the
+// vertices' distances differ by more than their separation and the interpolant crosses zero where no river is.
+// `dz`: the distance's screen derivatives. Call in uniform control flow.
+float distanceSlope(vec2 dz) {
+    vec3 px = dFdx(fPosition);
+    vec3 py = dFdy(fPosition);
+    float a = dot(px, px), b = dot(px, py), c = dot(py, py);
+    // |grad z|^2 on the triangle's plane: dz G^-1 dz with G the Gram matrix of the screen derivatives.
+    float g2 = (c * dz.x * dz.x - 2.0 * b * dz.x * dz.y + a * dz.y * dz.y) / max(a * c - b * b, 1e-30);
+    return sqrt(max(g2, 0.0));
+}
+
+// Beyond the thesis: the largest slope at which an interpolated distance is taken for a river's (sqrt 2 and a
+// margin for the curvature of the mesh on the sphere).
+const float RIVER_SLOPE_LIMIT = 1.6;
+
 void main() {
     vec3 sun = normalize(frame.sun.xyz);
     vec3 up = normalize(fDirection);
@@ -197,7 +216,10 @@ void main() {
     }
     float visible;
     vec3 q = rippleSpace(true, visible);
-    float edge = fwidth(fRiver.z) + 1e-4;
+    // Derivatives in uniform control flow, before any branch.
+    vec2 dz = vec2(dFdx(fRiver.z), dFdy(fRiver.z));
+    float edge = abs(dz.x) + abs(dz.y) + 1e-4;
+    bool measured = distanceSlope(dz) <= RIVER_SLOPE_LIMIT;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).
@@ -209,10 +231,12 @@ void main() {
     float ambient = 0.18 + 0.12 * max(dot(up, sun) + 0.3, 0.0);
     vec3 colour = albedo * (ambient + 0.85 * diffuse);
     // Section 8.4: paint a river the mesh is too coarse to carve (vertices not closer than half its width, the
-    // thesis's rule, in `auto`), from the signed distance and width; as water half a colour band deep.
+    // thesis's rule, in `auto`), from the signed distance and width; as water half a colour band deep. Not where
+    // the distance was measured to different rivers (beyond the thesis, distanceSlope).
     uint mode = waterMode();
     bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
-    float inside = paint && fRiver.w > 0.0 ? 1.0 - smoothstep(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
+    float inside = paint && measured && fRiver.w > 0.0
+                 ? 1.0 - smoothstep(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
     if (inside > 0.0) {
         vec3 water = viewMode() == 2 ? vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse)
                                      : waterSurface(true, 0.5 * frame.extra.z, q, visible, up, view, sun).rgb;

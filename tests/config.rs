@@ -52,19 +52,19 @@ fn appendix_a_reads_as_printed() {
 #[test]
 fn the_shipped_files_load_from_disk_with_their_models() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
-    for (file, model) in [
-        ("planet.xml", RiverModel::Drainage),
-        ("thesis.xml", RiverModel::Thesis),
-        ("earth.xml", RiverModel::Thesis),
+    // The drainage model's planet draws by screen-space error, the thesis's model by the thesis's Eq. 6.1.
+    for (file, model, rule) in [
+        (
+            "planet.xml",
+            RiverModel::Drainage,
+            LodRule::ScreenSpaceError,
+        ),
+        ("thesis.xml", RiverModel::Thesis, LodRule::Distance),
+        ("earth.xml", RiverModel::Thesis, LodRule::Distance),
     ] {
         let c = Config::load(&dir.join(file)).unwrap();
         assert_eq!(c.river.model, model, "{file}");
-        // Eq. 6.1 by default: screen-space error paints rivers from too coarse a mesh (docs/rendering.md).
-        assert_eq!(
-            c.rendering.level_of_detail_rule,
-            LodRule::Distance,
-            "{file}"
-        );
+        assert_eq!(c.rendering.level_of_detail_rule, rule, "{file}");
     }
 }
 
@@ -360,4 +360,16 @@ fn the_documentation_lists_exactly_the_elements_read() {
         })
         .collect();
     assert!(unknown.is_empty(), "documented but not read: {unknown:?}");
+}
+
+#[test]
+fn a_run_without_morphing_takes_the_thesis_rule_unless_another_is_asked_for() {
+    let screen = LodRule::ScreenSpaceError;
+    assert_eq!(LodRule::for_run(None, true, screen), screen);
+    assert_eq!(LodRule::for_run(None, false, screen), LodRule::Distance);
+    assert_eq!(LodRule::for_run(Some(screen), false, screen), screen);
+    assert_eq!(
+        LodRule::for_run(Some(LodRule::Distance), true, screen),
+        LodRule::Distance
+    );
 }

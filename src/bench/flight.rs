@@ -164,6 +164,17 @@ pub struct FlightOptions {
     pub vertex_cache: bool,
 }
 
+impl FlightOptions {
+    /// The level-of-detail rule of the flight (`LodRule::for_run`).
+    fn rule(&self, config: &Config) -> crate::config::LodRule {
+        crate::config::LodRule::for_run(
+            self.lod_rule,
+            self.morphing,
+            config.rendering.level_of_detail_rule,
+        )
+    }
+}
+
 /// The configuration of a flight: the thesis's stress test multiplies the switch factor by ten.
 pub fn flight_config(config: &Config, stress: bool) -> Config {
     let mut c = config.clone();
@@ -198,9 +209,7 @@ fn fly(
     renderer.atmosphere_on = options.atmosphere;
     renderer.cache_vertices = options.vertex_cache;
     renderer.set_frames_in_flight(options.frames_in_flight)?;
-    if let Some(rule) = options.lod_rule {
-        renderer.lod_rule = rule;
-    }
+    renderer.lod_rule = options.rule(config);
     // Each frame's kernel input, to rerun through every variant.
     let kernel_input: Rc<RefCell<KernelInput>> = Rc::default();
     if runner.is_some() {
@@ -495,9 +504,7 @@ pub fn flight_bench(
         vertex_cache: options.vertex_cache,
         parent_reuse: options.parent_reuse,
         frames_in_flight: options.frames_in_flight,
-        lod_rule: options
-            .lod_rule
-            .unwrap_or(config.rendering.level_of_detail_rule),
+        lod_rule: options.rule(&config),
         river_model: config.river.model,
         radius: world.planet.radius,
         seed: world.seed,

@@ -79,9 +79,11 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         let e = elevation.to_radians();
         renderer.sun = Some(ahead * e.cos() + up * e.sin());
     }
-    if let Some(rule) = args.lod_rule {
-        renderer.lod_rule = rule;
-    }
+    renderer.lod_rule = riverplanet::config::LodRule::for_run(
+        args.lod_rule,
+        renderer.morphing,
+        config.rendering.level_of_detail_rule,
+    );
     let altitude = eye.length() - config.planet.radius as f64;
     let mut camera = riverplanet::runtime::camera::Camera::look_at(
         eye,

@@ -123,10 +123,24 @@ pub struct RiverConfig {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LodRule {
-    /// Beyond the thesis: refine while a patch's geometric error would cover more than `pixel-error` pixels.
+    /// Beyond the thesis (the default of the drainage model): refine while a level's error would cover more than
+    /// `pixel-error` pixels.
     ScreenSpaceError,
-    /// The thesis's Eq. 6.1 (the default): refine while nearer than radius x switch factor / 2^level.
+    /// The thesis's Eq. 6.1 (the default of the thesis's model): refine while nearer than radius x switch factor
+    /// / 2^level.
     Distance,
+}
+
+impl LodRule {
+    /// The rule of a run: the one asked for; else, without morphing, Eq. 6.1 (the thesis's level of detail is Eq.
+    /// 6.1 with instant switching); else the configuration's.
+    pub fn for_run(asked: Option<LodRule>, morphing: bool, configured: LodRule) -> LodRule {
+        match asked {
+            Some(rule) => rule,
+            None if !morphing => LodRule::Distance,
+            None => configured,
+        }
+    }
 }
 
 impl crate::named::Named for LodRule {
@@ -166,8 +180,9 @@ pub struct Config {
 impl Config {
     /// The defaults of a file with `model`: Appendix A's values (`appendix_a`), and for the drainage model the
     /// values config/planet.xml was tuned with (docs/rivers.md): a river where 700
-    /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), and at most four
-    /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples).
+    /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), at most four
+    /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples), and the
+    /// screen-space-error level of detail (docs/rendering.md; the thesis's model keeps the thesis's Eq. 6.1).
     pub fn defaults_for(model: RiverModel) -> Self {
         let mut d = Self::appendix_a();
         d.river.model = model;
@@ -175,6 +190,7 @@ impl Config {
             d.planet.detail_amplitude = 2.0;
             d.river.source_area = 700.0;
             d.river.samples_per_vertex_spacing = 4;
+            d.rendering.level_of_detail_rule = LodRule::ScreenSpaceError;
         }
         d
     }

@@ -389,6 +389,16 @@ impl RiverNetwork {
             .sum();
         (self.systems.len(), tributaries)
     }
+
+    /// The full width of the widest water: the widest river's end or lake. Subdivision interpolates the initial
+    /// segments' widths and tributaries are narrower than their parents, so the initial segments bound it.
+    pub fn widest(&self) -> f64 {
+        self.systems
+            .iter()
+            .flat_map(|s| &s.segments)
+            .map(|segment| segment.widths.0.max(segment.widths.1) as f64)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Walks from `source` along the great circle of `tangent` until the terrain is sea; `None` if that takes more

@@ -22,6 +22,19 @@ pub fn threshold(radius: f64, switch_factor: f64, lod: u32) -> f64 {
     radius * switch_factor / (1u64 << lod) as f64
 }
 
+/// Beyond the thesis: the error of a level's river data, for the screen-space rule. The kernel measures rivers
+/// at the vertices within the influence distance of their samples (6.5), so on a level whose vertices are more
+/// than twice that apart (`spacing`, in the patch frame), a river or lake between two vertices reaches neither and
+/// is not drawn: water up to the widest's width (`widest`) is missing. Closer vertices always measure it, and
+/// banks interpolated from signed distances add no error of their own.
+pub fn river_error(spacing: f64, influence_distance: f64, widest: f64) -> f64 {
+    if spacing > 2.0 * influence_distance {
+        widest
+    } else {
+        0.0
+    }
+}
+
 /// The parameters of the selection: the switch distance of every level.
 #[derive(Clone, Debug)]
 pub struct LodParams {

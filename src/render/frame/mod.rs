@@ -108,6 +108,9 @@ pub struct Renderer<'w> {
     frozen: Option<Vec<Selected>>,
     /// This frame's switch distances (`lod_rule`, the camera and the viewport).
     lod: LodParams,
+    /// Per level, the error the screen-space rule projects: the terrain's (`Planet::geometric_error`) or what
+    /// the level's river data can miss (`lod::river_error`), whichever is larger.
+    level_errors: Vec<f64>,
     /// GPU milliseconds per new patch (base heights and river data), averaged over recent frames: what the
     /// generation budget divides by.
     generation_ms_per_patch: Option<f64>,
@@ -288,6 +291,7 @@ impl<'w> Renderer<'w> {
                 config.rendering.level_of_detail_switch_factor as f64,
                 config.rendering.max_level_of_detail,
             ),
+            level_errors: plan::level_errors(planet, network, config),
             lod_rule: config.rendering.level_of_detail_rule,
             generation_ms_per_patch: None,
             variant: KernelVariant::Tiled,

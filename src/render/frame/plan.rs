@@ -7,20 +7,36 @@ use std::time::Instant;
 
 use super::{ms_since, FrameStats, Renderer};
 use crate::{
-    config::LodRule,
+    config::{Config, LodRule},
     gpu::GpuError,
-    planet::cube::PatchId,
+    planet::{cube::PatchId, Planet},
     refine::with_ancestors,
+    river::network::RiverNetwork,
     runtime::{
         camera::Camera,
         cull::{visible_quadrants, Frustum, HeightRange},
-        lod::{select, select_nearest, surface_bounds, LodParams, Selected},
+        lod::{river_error, select, select_nearest, surface_bounds, LodParams, Selected},
     },
 };
 
+/// Per level 0..=max-level-of-detail, the error the screen-space rule projects: the terrain's geometric error or
+/// what the level's river data can miss, whichever is larger. The patch frame's vertex spacing is the face's
+/// width (2 radii) over the level's vertices.
+pub(super) fn level_errors(planet: &Planet, network: &RiverNetwork, config: &Config) -> Vec<f64> {
+    let widest = network.widest();
+    let segments = (config.rendering.vertices - 1) as f64;
+    (0..=config.rendering.max_level_of_detail)
+        .map(|level| {
+            let spacing = 2.0 * planet.radius / (segments * (1u64 << level) as f64);
+            let rivers = river_error(spacing, network.influence_distance, widest);
+            planet.geometric_error(level).max(rivers)
+        })
+        .collect()
+}
+
 impl Renderer<'_> {
-    /// The switch distances of this frame: Eq. 6.1, or the levels' geometric errors projected to `pixel-error`
-    /// pixels of a viewport `viewport_height` pixels high seen through `camera`.
+    /// The switch distances of this frame: Eq. 6.1, or the levels' errors (terrain or river data, `level_errors`)
+    /// projected to `pixel-error` pixels of a viewport `viewport_height` pixels high seen through `camera`.
     pub(super) fn lod_params(&self, camera: &Camera, viewport_height: u32) -> LodParams {
         let r = &self.config.rendering;
         let radius = self.planet.radius;
@@ -32,7 +48,7 @@ impl Renderer<'_> {
             ),
             LodRule::ScreenSpaceError => LodParams::screen_space(
                 radius,
-                |level| self.planet.geometric_error(level),
+                |level| self.level_errors[level as usize],
                 viewport_height as f64 / (2.0 * (0.5 * camera.fov_y).tan()),
                 r.pixel_error as f64,
                 r.max_level_of_detail,
