@@ -23,6 +23,10 @@ void main() {
     s.position = v.position;
     s.normal = shading.normal;
     s.river = v.surface;
+    // A vertex no river sample reaches (half width 0) holds the influence distance, whatever side it lies on; for
+    // painting it is far from every river (as a patch without rivers, terrain_vertex.glsl), so that a triangle
+    // reaching it paints no river between its vertices (terrain.frag, distanceSlope).
+    if (v.surface.w == 0.0) s.river.z = FAR_FROM_RIVERS;
     s.direction = v.direction;
     // The patch centre's world position (mod the period, from f64) plus the vertex's small offset from it.
     s.detail = p.detail.xyz + v.local;

@@ -57,12 +57,15 @@ float heightAt(PatchInstance p, vec2 grid, float morph) {
     return mix(river.x, base, river.y);
 }
 
+// The signed distance of a point no river reaches.
+const float FAR_FROM_RIVERS = 1e9;
+
 // Terrain height, water height, signed distance and half width at a grid position, from the patch's (or its
 // stand-in's) textures; `flow`: the water's flow in the patch frame.
 vec4 surfaceAt(PatchInstance p, vec2 grid, float morph, out vec2 flow) {
     float base = baseAt(p, grid);
     flow = vec2(0.0);
-    if (p.slots.y < 0) return vec4(base, frame.sun.w, 1e9, 0.0);
+    if (p.slots.y < 0) return vec4(base, frame.sun.w, FAR_FROM_RIVERS, 0.0);
     vec3 widthFlow;
     vec4 river = riverAt(p, grid, morph, widthFlow);
     flow = widthFlow.yz;
