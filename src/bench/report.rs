@@ -332,8 +332,8 @@ fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), Plo
     let _ = writeln!(
         w,
         "## The frame on the default planet\n\nBeyond the thesis: the scripted approach on config/planet.xml at the \
-         resolution given, in the default water mode, with each level-of-detail rule (`distance`, the thesis's \
-         Eq. 6.1, the default; `screen-space-error`), number of frames in flight, the atmosphere on (the \
+         resolution given, in the default water mode, with each level-of-detail rule (`screen-space-error`, the \
+         default; `distance`, the thesis's Eq. 6.1), number of frames in flight, the atmosphere on (the \
          default) or off, and the vertex cache on (the default) or off (the thesis's vertex shaders). Frame times \
          are wall-clock per frame, waits for the GPU included.\n\n\
          | report | level of detail | frames in flight | atmosphere | vertex cache | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) | vertex cache pass ms (GPU) |\n\
