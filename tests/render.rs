@@ -11,7 +11,7 @@ use riverplanet::{
     gpu::Context,
     render::{
         presets::{self, Preset},
-        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
+        target::Offscreen,
         Renderer, ViewMode, WaterMode,
     },
     runtime::camera::Camera,
@@ -236,25 +236,11 @@ fn paint_rivers_red(
     name: &str,
     k: u32,
 ) -> Vec<bool> {
-    let world = world();
-    let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
-    renderer.water_mode = WaterMode::Painted;
-    renderer.view_mode = ViewMode::PaintedRed;
-    renderer.lod_rule = rule;
-    renderer
-        .render_until_streamed(camera, &target.target(CLEAR), 100)
-        .unwrap();
-    let image = target.read(ctx).unwrap();
-    renderer.destroy();
+    let image = render_configured(ctx, config, camera, size, CLEAR, |r| {
+        r.water_mode = WaterMode::Painted;
+        r.view_mode = ViewMode::PaintedRed;
+        r.lod_rule = rule;
+    });
     image
         .save(out_dir().join(format!("painted-{name}-{k}-{rule:?}.png")))
         .unwrap();
@@ -326,9 +312,21 @@ fn render_cleared(
     clear: [f32; 4],
     setup: impl Fn(&mut Renderer),
 ) -> image::RgbaImage {
-    let world = world();
+    render_configured(ctx, &world().config, camera, size, clear, setup)
+}
+
+/// Renders with `config`'s rendering settings and the renderer configured by `setup`, until every visible patch
+/// has its own data.
+fn render_configured(
+    ctx: &Context,
+    config: &Config,
+    camera: &Camera,
+    size: [u32; 2],
+    clear: [f32; 4],
+    setup: impl Fn(&mut Renderer),
+) -> image::RgbaImage {
     let target = Offscreen::new(ctx, size[0], size[1]).unwrap();
-    let mut renderer = common::renderer(ctx, world);
+    let mut renderer = common::renderer_with(ctx, world(), config);
     setup(&mut renderer);
     renderer
         .render_until_streamed(camera, &target.target(clear), 100)

@@ -7,6 +7,7 @@
 use std::sync::OnceLock;
 
 use riverplanet::{
+    config::Config,
     gpu::{Access, Context, ContextOptions},
     render::{
         target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
@@ -71,11 +72,17 @@ pub fn assert_no_validation_errors(ctx: &Context) {
 
 /// A renderer of `world` for the offscreen target's formats.
 pub fn renderer<'a>(ctx: &'a Context, world: &'a World) -> Renderer<'a> {
+    renderer_with(ctx, world, &world.config)
+}
+
+/// A renderer of `world`'s planet and rivers with `config`'s rendering settings, for the offscreen target's
+/// formats.
+pub fn renderer_with<'a>(ctx: &'a Context, world: &'a World, config: &'a Config) -> Renderer<'a> {
     Renderer::new(
         ctx,
         &world.planet,
         &world.network,
-        &world.config,
+        config,
         COLOR_FORMAT,
         DEPTH_FORMAT,
     )
