@@ -114,6 +114,23 @@ impl Renderer<'_> {
         ]
     }
 
+    /// Beyond the thesis: whether a vertex of `patch` can lie beyond its level's switch distance. There it is fully
+    /// morphed beside partly morphed neighbours, and the grid triangles between them have their corners on one grid
+    /// line: thin walls over the step between the two morph factors' heights, which face away from the camera as
+    /// often as not and must not be culled, or a pixel they alone cover shows through (docs/rendering.md, "Back
+    /// faces and morphing"). Bounded by the distance to the patch's centre at the middle of its surface's heights
+    /// `(lo, hi)` plus how far its vertices can lie from that point.
+    fn reaches_switch_distance(&self, patch: PatchId, (lo, hi): (f32, f32), camera: DVec3) -> bool {
+        if !self.morphing || patch.level == 0 {
+            return false;
+        }
+        let (lo, hi) = (lo as f64, hi as f64);
+        let outer = self.planet.radius + hi.abs().max(lo.abs());
+        let centre = patch.center() * (self.planet.radius + 0.5 * (lo + hi));
+        let reach = outer * patch.cap_angle() + 0.5 * (hi - lo);
+        camera.distance(centre) + reach >= self.lod.threshold(patch.level as u32)
+    }
+
     /// The visible patches drawn from an ancestor's data, each with how far its surface can lie from the true one:
     /// the span of that ancestor's heights (base and river beds).
     fn stand_in_spans(&self, visible: &[Selected]) -> StandIns {
@@ -156,7 +173,9 @@ impl Renderer<'_> {
         // per quadrant for the terrain (the instances that draw it), then one for the water (patches with a river
         // or below sea level), all in one buffer.
         let stand_ins = self.stand_in_spans(visible);
-        let mut drawn: Vec<(PatchInstance, bool, PatchId)> = Vec::with_capacity(visible.len());
+        // Each with whether its water shows (a river or land below sea level) and whether its back faces are culled.
+        let mut drawn: Vec<(PatchInstance, bool, PatchId, bool)> =
+            Vec::with_capacity(visible.len());
         for s in visible {
             let source = if self.cache.contains(&s.patch) {
                 stats.deepest_level = stats.deepest_level.max(s.patch.level as u32);
@@ -188,7 +207,9 @@ impl Renderer<'_> {
             instance.slots[3] = parent_river;
             instance.tex_rect[3] =
                 SKIRT_SPACINGS * instance.centre_dir[3] + skirt_deficit(s.patch, &stand_ins);
-            drawn.push((instance, wet, s.patch));
+            let range = data.surface_range();
+            let cull = !self.reaches_switch_distance(s.patch, range, camera.position);
+            drawn.push((instance, wet, s.patch, cull));
         }
         // Near to far, so that depth testing rejects what nearer patches hide before it is shaded.
         drawn.sort_by(|a, b| {
@@ -201,33 +222,35 @@ impl Renderer<'_> {
         } else {
             0
         };
-        for (k, (instance, _, _)) in drawn.iter_mut().enumerate() {
+        for (k, (instance, _, _, _)) in drawn.iter_mut().enumerate() {
             instance.detail[3] = if k < cached { k as f32 } else { -1.0 };
         }
         let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 4);
-        instances.extend(drawn.iter().map(|(i, _, _)| *i));
+        instances.extend(drawn.iter().map(|(i, _, _, _)| *i));
         let first_terrain_instance = instances.len();
         let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
         // The terrain's draws: each quadrant's cells and edge skirts for the instances that draw it, and its
-        // midline skirts only for those that leave the quadrant across the midline to finer patches.
+        // midline skirts only for those that leave the quadrant across the midline to finer patches; each once for
+        // the patches whose back faces are culled and once for those reaching their switch distance.
         let has = |i: &PatchInstance, q: usize| i.slots[2] & (1 << q) != 0;
-        let mut terrain_draws: Vec<(Range<u32>, Range<u32>)> = Vec::with_capacity(12);
-        for (q, mesh) in self.quadrants.iter().enumerate() {
-            let parts = [
-                (mesh.core.clone(), None),
-                (mesh.across[0].clone(), Some(q ^ 1)),
-                (mesh.across[1].clone(), Some(q ^ 2)),
-            ];
-            for (indices, across) in parts {
-                let first = instances.len() as u32;
-                for (instance, _, patch) in drawn
-                    .iter()
-                    .filter(|(i, _, _)| has(i, q) && across.is_none_or(|a| !has(i, a)))
-                {
-                    instances.push(*instance);
-                    instance_patches.push(*patch);
+        let mut terrain_draws: Vec<(Range<u32>, Range<u32>, bool)> = Vec::with_capacity(24);
+        for cull in [true, false] {
+            for (q, mesh) in self.quadrants.iter().enumerate() {
+                let parts = [
+                    (mesh.core.clone(), None),
+                    (mesh.across[0].clone(), Some(q ^ 1)),
+                    (mesh.across[1].clone(), Some(q ^ 2)),
+                ];
+                for (indices, across) in parts {
+                    let first = instances.len() as u32;
+                    for (instance, _, patch, _) in drawn.iter().filter(|(i, _, _, c)| {
+                        *c == cull && has(i, q) && across.is_none_or(|a| !has(i, a))
+                    }) {
+                        instances.push(*instance);
+                        instance_patches.push(*patch);
+                    }
+                    terrain_draws.push((indices, first..instances.len() as u32, cull));
                 }
-                terrain_draws.push((indices, first..instances.len() as u32));
             }
         }
         // Cached patches draw their water through the cache pass's indirect draws (instance k is patch k); the
@@ -237,8 +260,8 @@ impl Renderer<'_> {
             drawn
                 .iter()
                 .skip(cached)
-                .filter(|(_, wet, _)| *wet)
-                .map(|(i, _, _)| *i),
+                .filter(|(_, wet, _, _)| *wet)
+                .map(|(i, _, _, _)| *i),
         );
         let water_instances = first..instances.len() as u32;
         let instance_buffer = {
@@ -331,12 +354,15 @@ impl Renderer<'_> {
         );
         rec.begin_rendering(target, true);
         let scope = self.frames.profiler().begin(rec, "terrain")?;
-        let terrain = if self.wireframe_on {
-            &self.wireframe
-        } else {
-            &self.terrain
-        };
-        for (indices, instances) in terrain_draws {
+        for (indices, instances, cull) in terrain_draws {
+            if instances.is_empty() {
+                continue;
+            }
+            let terrain = match (self.wireframe_on, cull) {
+                (true, _) => &self.wireframe,
+                (false, true) => &self.terrain,
+                (false, false) => &self.terrain_unculled,
+            };
             stats.terrain_triangles += (indices.len() / 3 * instances.len()) as u64;
             rec.draw_indexed(terrain, &sets, push, &self.indices, indices, instances);
         }

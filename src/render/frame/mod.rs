@@ -81,6 +81,9 @@ pub struct Renderer<'w> {
     kernel: RiverKernel,
     refiner: HeightRefiner,
     terrain: GraphicsPipeline,
+    /// The terrain without back-face culling, for patches that reach their switch distance (draw.rs,
+    /// `reaches_switch_distance`).
+    terrain_unculled: GraphicsPipeline,
     water: GraphicsPipeline,
     /// The water of patches in the vertex cache, from the triangles its passes list (no geometry shader).
     cached_water: GraphicsPipeline,
@@ -184,7 +187,7 @@ impl<'w> Renderer<'w> {
         // The terrain is drawn per quadrant without a geometry shader, back faces culled; the water pass has the
         // geometry shader that spawns water triangles, except for the cached patches, whose water triangles the
         // vertex cache's passes list (docs/rendering.md). Water is blended over the terrain and writes no depth.
-        let pipeline = |name: &str, vertex, geometry, water: bool, wireframe: bool| {
+        let pipeline = |name: &str, vertex, geometry, water: bool, wireframe: bool, cull: bool| {
             GraphicsPipeline::new(
                 ctx,
                 &GraphicsDesc {
@@ -201,18 +204,27 @@ impl<'w> Renderer<'w> {
                     depth_test: true,
                     blend: if water { Blend::Alpha } else { Blend::None },
                     wireframe,
-                    // The terrain with its skirts is closed (render/mesh.rs); water triangles come in either
-                    // winding.
-                    cull_back_faces: !water,
+                    cull_back_faces: cull,
                 },
             )
         };
-        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, false, false)?;
+        // The terrain with its skirts is closed (render/mesh.rs), so its back faces are hidden, except where
+        // morphing leaves walls (terrain_unculled); water triangles come in either winding.
+        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, false, false, true)?;
+        let terrain_unculled = pipeline(
+            "terrain, not culled",
+            shaders::TERRAIN_VERT,
+            None,
+            false,
+            false,
+            false,
+        )?;
         let water = pipeline(
             "water",
             shaders::WATER_VERT,
             Some(shaders::TERRAIN_GEOM),
             true,
+            false,
             false,
         )?;
         let cached_water = pipeline(
@@ -221,12 +233,14 @@ impl<'w> Renderer<'w> {
             None,
             true,
             false,
+            false,
         )?;
         let wireframe = pipeline(
             "terrain wireframe",
             shaders::TERRAIN_VERT,
             None,
             false,
+            true,
             true,
         )?;
         let air = Atmosphere::new(
@@ -268,6 +282,7 @@ impl<'w> Renderer<'w> {
             kernel,
             refiner,
             terrain,
+            terrain_unculled,
             water,
             cached_water,
             wireframe,
