@@ -831,3 +831,36 @@ fn a_recorded_camera_path_replays_in_render_and_bench_flight() {
     assert_eq!(report["recorded_path"], true);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A whole run, from device creation to its destruction, leaves the validation layer nothing to report: every
+/// pipeline, buffer and image is destroyed before the device (the layer reports leaks only then, after the
+/// library's own checks in the other tests).
+#[test]
+fn a_render_destroys_everything_it_made_before_the_device() {
+    if std::env::var("RIVERPLANET_REQUIRE_GPU").is_err() {
+        return;
+    }
+    let dir = temp_dir("teardown");
+    let out = dir.join("r.png");
+    let run = riverplanet()
+        .args([
+            "render",
+            "--seed",
+            "1",
+            "--preset",
+            "mountains",
+            "--size",
+            "160x90",
+            "--out",
+        ])
+        .arg(&out)
+        .env("RIVERPLANET_VALIDATION", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "render failed: {stderr}");
+    assert!(
+        !stderr.contains("Validation Error"),
+        "the validation layer reported errors:\n{stderr}"
+    );
+}

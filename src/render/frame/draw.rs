@@ -173,9 +173,7 @@ impl Renderer<'_> {
         // per quadrant for the terrain (the instances that draw it), then one for the water (patches with a river
         // or below sea level), all in one buffer.
         let stand_ins = self.stand_in_spans(visible);
-        // Each with whether its water shows (a river or land below sea level) and whether its back faces are culled.
-        let mut drawn: Vec<(PatchInstance, bool, PatchId, bool)> =
-            Vec::with_capacity(visible.len());
+        let mut drawn: Vec<DrawnPatch> = Vec::with_capacity(visible.len());
         for s in visible {
             let source = if self.cache.contains(&s.patch) {
                 stats.deepest_level = stats.deepest_level.max(s.patch.level as u32);
@@ -208,13 +206,17 @@ impl Renderer<'_> {
             instance.tex_rect[3] =
                 SKIRT_SPACINGS * instance.centre_dir[3] + skirt_deficit(s.patch, &stand_ins);
             let range = data.surface_range();
-            let cull = !self.reaches_switch_distance(s.patch, range, camera.position);
-            drawn.push((instance, wet, s.patch, cull));
+            drawn.push(DrawnPatch {
+                instance,
+                wet,
+                patch: s.patch,
+                culled: !self.reaches_switch_distance(s.patch, range, camera.position),
+            });
         }
         // Near to far, so that depth testing rejects what nearer patches hide before it is shaded.
         drawn.sort_by(|a, b| {
             let distance = |p: &PatchId| camera.position.distance_squared(p.center() * radius);
-            distance(&a.2).total_cmp(&distance(&b.2))
+            distance(&a.patch).total_cmp(&distance(&b.patch))
         });
         // The drawn patches first, once each: the vertex cache's entries (instance k fills entry k).
         let cached = if self.cache_vertices {
@@ -222,17 +224,17 @@ impl Renderer<'_> {
         } else {
             0
         };
-        for (k, (instance, _, _, _)) in drawn.iter_mut().enumerate() {
-            instance.detail[3] = if k < cached { k as f32 } else { -1.0 };
+        for (k, d) in drawn.iter_mut().enumerate() {
+            d.instance.detail[3] = if k < cached { k as f32 } else { -1.0 };
         }
         let mut instances: Vec<PatchInstance> = Vec::with_capacity(drawn.len() * 4);
-        instances.extend(drawn.iter().map(|(i, _, _, _)| *i));
+        instances.extend(drawn.iter().map(|d| d.instance));
         let first_terrain_instance = instances.len();
         let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
         // The terrain's draws: each quadrant's cells and edge skirts for the instances that draw it, and its
         // midline skirts only for those that leave the quadrant across the midline to finer patches; each once for
         // the patches whose back faces are culled and once for those reaching their switch distance.
-        let has = |i: &PatchInstance, q: usize| i.slots[2] & (1 << q) != 0;
+        let has = |d: &DrawnPatch, q: usize| d.instance.slots[2] & (1 << q) != 0;
         let mut terrain_draws: Vec<(Range<u32>, Range<u32>, bool)> = Vec::with_capacity(24);
         for cull in [true, false] {
             for (q, mesh) in self.quadrants.iter().enumerate() {
@@ -243,11 +245,11 @@ impl Renderer<'_> {
                 ];
                 for (indices, across) in parts {
                     let first = instances.len() as u32;
-                    for (instance, _, patch, _) in drawn.iter().filter(|(i, _, _, c)| {
-                        *c == cull && has(i, q) && across.is_none_or(|a| !has(i, a))
+                    for d in drawn.iter().filter(|d| {
+                        d.culled == cull && has(d, q) && across.is_none_or(|a| !has(d, a))
                     }) {
-                        instances.push(*instance);
-                        instance_patches.push(*patch);
+                        instances.push(d.instance);
+                        instance_patches.push(d.patch);
                     }
                     terrain_draws.push((indices, first..instances.len() as u32, cull));
                 }
@@ -260,8 +262,8 @@ impl Renderer<'_> {
             drawn
                 .iter()
                 .skip(cached)
-                .filter(|(_, wet, _, _)| *wet)
-                .map(|(i, _, _, _)| *i),
+                .filter(|d| d.wet)
+                .map(|d| d.instance),
         );
         let water_instances = first..instances.len() as u32;
         let instance_buffer = {
@@ -452,6 +454,16 @@ fn skirt_deficit(patch: PatchId, spans: &StandIns) -> f32 {
         .chain(EDGES.map(|e| patch.neighbour(e)))
         .map(|p| covering(p).max(spans.below.get(&p).copied().unwrap_or(0.0)))
         .fold(0.0, f32::max)
+}
+
+/// A visible patch as this frame draws it.
+struct DrawnPatch {
+    instance: PatchInstance,
+    /// Whether it has water to draw: a river or land below sea level.
+    wet: bool,
+    patch: PatchId,
+    /// Whether its back faces are culled (not where morphing can leave walls: `reaches_switch_distance`).
+    culled: bool,
 }
 
 /// The visible patches drawn from an ancestor's data with the span of that ancestor's heights, and for every

@@ -71,6 +71,18 @@ fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// The pipelines that draw the surface with terrain.frag.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum SurfacePipeline {
+    /// Terrain, back faces culled.
+    Culled,
+    /// Terrain that can show its back faces (patches reaching their switch distance).
+    Unculled,
+    Wireframe,
+    /// Water, blended.
+    Water,
+}
+
 /// The renderer of one planet.
 pub struct Renderer<'w> {
     ctx: &'w Context,
@@ -184,10 +196,12 @@ impl<'w> Renderer<'w> {
         })?;
         let layouts = [bindless.layout, instance_layout.layout];
         let vertex_cache = vertex_cache::VertexCache::new(ctx, &layouts)?;
-        // The terrain is drawn per quadrant without a geometry shader, back faces culled; the water pass has the
-        // geometry shader that spawns water triangles, except for the cached patches, whose water triangles the
-        // vertex cache's passes list (docs/rendering.md). Water is blended over the terrain and writes no depth.
-        let pipeline = |name: &str, vertex, geometry, water: bool, wireframe: bool, cull: bool| {
+        // The terrain is drawn per quadrant without a geometry shader, back faces culled where nothing can show
+        // through them (docs/rendering.md, "Back faces and morphing"); the water pass has the geometry shader that
+        // spawns water triangles, except for the cached patches, whose water triangles the vertex cache's passes
+        // list (docs/rendering.md). Water is blended over the terrain, writes no depth and comes in either winding.
+        let pipeline = |name: &str, vertex, geometry, kind: SurfacePipeline| {
+            let water = kind == SurfacePipeline::Water;
             GraphicsPipeline::new(
                 ctx,
                 &GraphicsDesc {
@@ -203,46 +217,26 @@ impl<'w> Renderer<'w> {
                     depth_write: !water,
                     depth_test: true,
                     blend: if water { Blend::Alpha } else { Blend::None },
-                    wireframe,
-                    cull_back_faces: cull,
+                    wireframe: kind == SurfacePipeline::Wireframe,
+                    cull_back_faces: matches!(
+                        kind,
+                        SurfacePipeline::Culled | SurfacePipeline::Wireframe
+                    ),
                 },
             )
         };
-        // The terrain with its skirts is closed (render/mesh.rs), so its back faces are hidden, except where
-        // morphing leaves walls (terrain_unculled); water triangles come in either winding.
-        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, false, false, true)?;
-        let terrain_unculled = pipeline(
-            "terrain, not culled",
-            shaders::TERRAIN_VERT,
-            None,
-            false,
-            false,
-            false,
-        )?;
+        use SurfacePipeline::{Culled, Unculled, Water, Wireframe};
+        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, Culled)?;
+        let terrain_unculled =
+            pipeline("terrain, not culled", shaders::TERRAIN_VERT, None, Unculled)?;
         let water = pipeline(
             "water",
             shaders::WATER_VERT,
             Some(shaders::TERRAIN_GEOM),
-            true,
-            false,
-            false,
+            Water,
         )?;
-        let cached_water = pipeline(
-            "cached water",
-            shaders::WATER_SURFACE_VERT,
-            None,
-            true,
-            false,
-            false,
-        )?;
-        let wireframe = pipeline(
-            "terrain wireframe",
-            shaders::TERRAIN_VERT,
-            None,
-            false,
-            true,
-            true,
-        )?;
+        let cached_water = pipeline("cached water", shaders::WATER_SURFACE_VERT, None, Water)?;
+        let wireframe = pipeline("terrain wireframe", shaders::TERRAIN_VERT, None, Wireframe)?;
         let air = Atmosphere::new(
             planet.radius,
             planet.sea_level as f64,
@@ -510,6 +504,7 @@ impl<'w> Renderer<'w> {
         self.kernel.destroy(ctx);
         self.refiner.destroy(ctx);
         self.terrain.destroy(ctx);
+        self.terrain_unculled.destroy(ctx);
         self.water.destroy(ctx);
         self.cached_water.destroy(ctx);
         self.wireframe.destroy(ctx);
