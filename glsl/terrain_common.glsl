@@ -38,8 +38,9 @@ struct PatchInstance {
     vec4 axisV;       // xyz: the same along j; w: 2 cubeCentre . axisV
     vec4 texRect;     // xy: source texel of vertex (0, 0); z: source texels per vertex; w: skirt length
     ivec4 slots;      // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: parent's river slot or -1
-    vec4 morph;       // x: distance where morphing towards the parent starts; y: 1 / morph band length;
-                      // zw: the patch's vertex (0, 0) in its parent's river texture
+    vec4 morph;       // x: share of the switch distance where morphing towards the parent starts; y: 1 / the
+                      // morph band's share; zw: the patch's vertex (0, 0) in its parent's river texture
+    vec4 switchDistances; // at the corners (0, 0), (n-1, 0), (0, n-1), (n-1, n-1); bilinear between them
     vec4 detail;      // xyz: the patch centre's world position modulo DETAIL_PERIOD (computed in f64)
 };
 

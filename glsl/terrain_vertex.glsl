@@ -75,9 +75,18 @@ vec4 surfaceAt(PatchInstance p, vec2 grid, float morph, out vec2 flow) {
 }
 
 // Beyond the thesis (CDLOD, Strugar 2009): how far a vertex has morphed towards its parent's mesh, from its
-// distance to the camera: 0 inside the morph band's start, 1 from the patch level's switch distance on.
-float morphFactor(PatchInstance p, float distance) {
-    return clamp((distance - p.morph.x) * p.morph.y, 0.0, 1.0);
+// distance to the camera: 0 inside the morph band's start, 1 from the switch distance at its grid position on.
+// The switch distance is bilinear between the patch's corners, written as a(1 - t) + bt so that an edge's
+// vertices take the same value in both patches that share it (runtime/error_field.rs).
+float switchDistance(PatchInstance p, vec2 grid) {
+    vec2 t = grid / (frame.planet.y - 1.0);
+    vec4 d = p.switchDistances;
+    float low = d.x * (1.0 - t.x) + d.y * t.x;
+    float high = d.z * (1.0 - t.x) + d.w * t.x;
+    return low * (1.0 - t.y) + high * t.y;
+}
+float morphFactor(PatchInstance p, vec2 grid, float distance) {
+    return clamp((distance / switchDistance(p, grid) - p.morph.x) * p.morph.y, 0.0, 1.0);
 }
 
 // Camera-relative position: the patch centre relative to the camera (f64 on the CPU), plus the small offset of the
@@ -149,7 +158,7 @@ TerrainVertex terrainVertex(PatchInstance p, int id) {
     v.grid = vec2(meshGrid(id, v.edge));
     // The morph distance is the unmorphed vertex's, from its base height, which neighbouring patches share bit for
     // bit.
-    v.morph = morphFactor(p, length(positionAt(p, baseAt(p, v.grid), directionOffset(p, v.grid))));
+    v.morph = morphFactor(p, v.grid, length(positionAt(p, baseAt(p, v.grid), directionOffset(p, v.grid))));
     v.morphed = morphedGrid(v.grid, v.morph);
     vec2 flow;
     v.surface = surfaceAt(p, v.morphed, v.morph, flow);

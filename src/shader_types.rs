@@ -146,10 +146,13 @@ pub struct PatchInstance {
     pub tex_rect: [f32; 4],
     pub slots: [i32; 4],
     pub morph: [f32; 4],
+    /// The switch distances at the patch's corners (0,0), (1,0), (0,1), (1,1) (`LodParams::switch_distances`).
+    pub switch_distances: [f32; 4],
     /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
     pub detail: [f32; 4],
 }
 
-const _: () = assert!(size_of::<PatchInstance>() == 9 * 16);
+const _: () = assert!(size_of::<PatchInstance>() == 10 * 16);
 const _: () = assert!(offset_of!(PatchInstance, slots) == 6 * 16);
-const _: () = assert!(offset_of!(PatchInstance, detail) == 8 * 16);
+const _: () = assert!(offset_of!(PatchInstance, switch_distances) == 8 * 16);
+const _: () = assert!(offset_of!(PatchInstance, detail) == 9 * 16);

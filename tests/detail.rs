@@ -222,9 +222,10 @@ fn gpu_refinement_equals_the_cpu_reference_bit_for_bit() {
     bindless.destroy(ctx);
 }
 
-/// The screen-space error's bound (`Planet::geometric_error`, beyond the thesis): no vertex of the finest drawn
-/// level stands further from a coarser patch's surface (bilinear between its vertices) than that level's error,
-/// and the bound is not vacuous (some level comes within half of it).
+/// The screen-space error's bounds (beyond the thesis): no vertex of the finest drawn level stands further from a
+/// coarser patch's surface (bilinear between its vertices) than the error of the quadrant it lies in
+/// (`Planet::quadrant_error`), nor than that level's error anywhere (`Planet::geometric_error`, their largest), and
+/// the bounds are not vacuous (some quadrant comes within half of its own).
 #[test]
 fn geometric_errors_bound_the_finest_drawn_surface() {
     let planet = planet(6, 3);
@@ -249,6 +250,15 @@ fn geometric_errors_bound_the_finest_drawn_surface() {
                 x: coarse.x * scale + rng.below(scale as u64) as u32,
                 y: coarse.y * scale + rng.below(scale as u64) as u32,
             };
+            let quadrant = PatchId {
+                face: fine.face,
+                level: level + 1,
+                x: fine.x >> (finest - level - 1),
+                y: fine.y >> (finest - level - 1),
+            };
+            let bound = planet.quadrant_error(quadrant);
+            assert!(bound <= planet.geometric_error(level as u32));
+            let mut quadrant_worst = 0.0f64;
             let (c, f) = (planet.patch_heights(coarse), planet.patch_heights(fine));
             for j in 0..n {
                 for i in 0..n {
@@ -265,16 +275,21 @@ fn geometric_errors_bound_the_finest_drawn_surface() {
                     let h = |di: i64, dj: i64| c.get(ci + di, cj + dj) as f64;
                     let bilinear = (h(0, 0) * (1.0 - fx) + h(1, 0) * fx) * (1.0 - fy)
                         + (h(0, 1) * (1.0 - fx) + h(1, 1) * fx) * fy;
-                    worst = worst.max((f.get(i, j) as f64 - bilinear).abs());
+                    quadrant_worst = quadrant_worst.max((f.get(i, j) as f64 - bilinear).abs());
                 }
             }
+            assert!(
+                quadrant_worst <= bound,
+                "{quadrant:?}: a level-{finest} vertex stands {quadrant_worst} from its parent's surface, error {bound}"
+            );
+            tightest = tightest.max(quadrant_worst / bound);
+            worst = worst.max(quadrant_worst);
         }
         let bound = planet.geometric_error(level as u32);
         assert!(
             worst <= bound,
             "level {level}: a level-{finest} vertex stands {worst} from the surface, error {bound}"
         );
-        tightest = tightest.max(worst / bound);
     }
     assert!(
         tightest > 0.5,

@@ -1,6 +1,6 @@
 //! Level of detail and culling against brute force and ray casting.
 
-use std::collections::BTreeSet;
+use std::{collections::BTreeSet, sync::Arc};
 
 use glam::{DVec3, DVec4};
 use riverplanet::{
@@ -9,6 +9,7 @@ use riverplanet::{
     runtime::{
         camera::Camera,
         cull::{beyond_horizon, visible_quadrants, Frustum, HeightRange},
+        error_field::ErrorField,
         lod::{refines, select, LodParams, Selected},
     },
 };
@@ -87,21 +88,48 @@ fn uneven_error(level: u32) -> f64 {
     }
 }
 
-/// Screen-space error: no drawn quadrant (below the deepest level) shows more than the allowed pixels of its
-/// patch's error at the quadrant's nearest distance, and switch distances at least halve per level (patches meet
-/// only patches one level apart).
+/// The error of drawing `patch`'s parent over it: `uneven_error` of the parent level on one face's rough half
+/// (x below half the level's count), a tenth of it elsewhere, as mountains beside plains.
+fn quadrant_error(patch: PatchId) -> f64 {
+    let parent = patch.level as u32 - 1;
+    let rough = patch.face == 4 && patch.x < patch.count() / 2;
+    uneven_error(parent) * if rough { 1.0 } else { 0.1 }
+}
+
+/// The error of a child of `level` anywhere: the largest quadrant error down to level 4 (the precomputed levels
+/// of a planet), a small one below (what diamond-square adds, the same everywhere).
+fn level_error(level: u32) -> f64 {
+    uneven_error(level - 1) * if level <= 4 { 1.0 } else { 0.05 }
+}
+
+/// The error of drawing the parent of `patch` over it, as the field has it.
+fn own_error(patch: PatchId) -> f64 {
+    match patch.level {
+        1..=4 => quadrant_error(patch),
+        level => level_error(level as u32),
+    }
+}
+
+/// The field the test selections use: quadrant errors down to level 4, one error per level below.
+fn error_field(max_level: u32) -> Arc<ErrorField> {
+    Arc::new(ErrorField::new(max_level, 4, quadrant_error, level_error))
+}
+
+/// Every patch of `level`.
+fn patches(level: u8) -> impl Iterator<Item = PatchId> {
+    let n = 1u32 << level;
+    (0..FACES as u8).flat_map(move |face| {
+        (0..n).flat_map(move |y| (0..n).map(move |x| PatchId { face, level, x, y }))
+    })
+}
+
+/// Screen-space error: no drawn quadrant (below the deepest level) shows more than the allowed pixels of its own
+/// error (the parent's surface over it) at the quadrant's distance, and the flat half of the rough face is drawn
+/// with fewer patches than the rough half (the error field spends triangles where the error is).
 #[test]
 fn screen_space_error_selection_never_draws_more_than_the_allowed_pixels() {
     let (pixels_per_radian, pixels) = (720.0 / (2.0 * (22.5f64).to_radians().tan()), 2.0);
-    let p = LodParams::screen_space(RADIUS, uneven_error, pixels_per_radian, pixels, 7);
-    for level in 1..p.max_level {
-        assert!(
-            p.threshold(level) >= 2.0 * p.threshold(level + 1),
-            "level {level}: {} < 2 x {}",
-            p.threshold(level),
-            p.threshold(level + 1)
-        );
-    }
+    let p = LodParams::screen_space(RADIUS, error_field(7), pixels_per_radian, pixels, 7);
     let mut rng = Rng::new(5, &[]);
     let mut checked = 0;
     for _ in 0..100 {
@@ -113,7 +141,7 @@ fn screen_space_error_selection_never_draws_more_than_the_allowed_pixels() {
             for q in (0..4).filter(|q| s.quadrants & (1 << q) != 0) {
                 let quadrant = s.patch.child(q);
                 let distance = camera.distance(quadrant.center() * RADIUS);
-                let shown = uneven_error(s.patch.level as u32) * pixels_per_radian / distance;
+                let shown = own_error(quadrant) * pixels_per_radian / distance;
                 assert!(
                     shown <= pixels * (1.0 + 1e-9),
                     "{:?} quadrant {q} shows {shown:.2} pixels of error at {distance:.1}",
@@ -124,6 +152,69 @@ fn screen_space_error_selection_never_draws_more_than_the_allowed_pixels() {
         }
     }
     assert!(checked > 1000, "only {checked} quadrants checked");
+    // Above the middle of face 4, between its rough and its flat half.
+    let camera = cube::sphere_point(4, 0.0, 0.0) * (RADIUS + 30.0);
+    let (rough, flat) = select(camera, &p)
+        .iter()
+        .filter(|s| s.patch.face == 4)
+        .fold((0, 0), |(r, f), s| {
+            if s.patch.x < s.patch.count() / 2 {
+                (r + 1, f)
+            } else {
+                (r, f + 1)
+            }
+        });
+    assert!(
+        2 * flat < rough,
+        "the flat half draws {flat} patches, the rough half {rough}"
+    );
+}
+
+/// The error field's switch distances: never below a patch's own error; at every patch's corners at least twice
+/// its children's (switch distances halve per level, so patches meet only patches one level apart); the same at a
+/// corner for every patch that shares it, on any face (neighbours morph alike along their shared edge).
+#[test]
+fn error_field_bounds_nests_and_agrees_at_shared_corners() {
+    let field = error_field(6);
+    let mut corner_values: Vec<(DVec3, f64)> = Vec::new();
+    for level in 1..=6u8 {
+        for patch in patches(level) {
+            let corners = field.corners(patch);
+            let own = own_error(patch);
+            assert!(
+                corners.iter().all(|&c| c >= own),
+                "{patch:?}: {corners:?} below {own}"
+            );
+            if level < 6 {
+                let children = (0..4)
+                    .flat_map(|q| field.corners(patch.child(q)))
+                    .fold(0.0, f64::max);
+                assert!(
+                    corners.iter().all(|&c| c >= 2.0 * children),
+                    "{patch:?}: {corners:?} less than twice its children's {children}"
+                );
+            }
+            if level == 3 {
+                corner_values.extend(patch.corners().into_iter().zip(corners));
+            }
+        }
+    }
+    // Corners of level 3 that lie at the same place (within rounding) hold the same value.
+    corner_values.sort_by(|a, b| a.0.x.total_cmp(&b.0.x));
+    let mut shared = 0;
+    for (k, (p, v)) in corner_values.iter().enumerate() {
+        for (q, w) in corner_values[k + 1..]
+            .iter()
+            .take_while(|(q, _)| q.x - p.x < 1e-9)
+        {
+            if p.distance(*q) < 1e-9 {
+                assert_eq!(v, w, "corner {p} holds {v} and {w}");
+                shared += 1;
+            }
+        }
+    }
+    // Every corner of level 3 is shared by four patches (three at the cube's corners).
+    assert!(shared > 6 * 64 * 4, "only {shared} shared corners");
 }
 
 #[test]

@@ -288,24 +288,29 @@ impl FaceLattice {
         levels
     }
 
-    /// Per level 0..`top` (this lattice being level `top` with `n` vertices per patch edge): the largest vertical
-    /// distance between a lattice point and the bilinear surface through the vertices of that level's patches,
-    /// i.e. how far a patch of that level can stand from this lattice (the geometric error of screen-space-error
-    /// level of detail, docs/rendering.md).
-    pub fn level_deviations(&self, top: u32, n: u32) -> Vec<f32> {
-        (0..top)
+    /// Per level 1..=`top` (index level - 1; this lattice being level `top` with `n` vertices per patch edge), per
+    /// patch of that level (face, then row-major): the largest vertical distance between a lattice point in the
+    /// patch's closed area and the bilinear surface through its parent's vertices there, i.e. how far drawing the
+    /// parent's quadrant instead of the patch can stand from this lattice (the screen-space rule's error,
+    /// docs/rendering.md). A quadrant holds `(n - 1) / 2` of its parent's cells per edge.
+    pub fn quadrant_deviations(&self, top: u32, n: u32) -> Vec<Vec<f32>> {
+        (1..=top)
             .map(|level| {
-                let stride = 1u32 << (top - level);
-                let vertices = (n - 1) << level;
-                (0..FACES)
+                let count = 1u32 << level;
+                // The parent's vertex spacing in lattice points, and the quadrant's width in lattice points.
+                let stride = 1u32 << (top + 1 - level);
+                let width = (n - 1) / 2 * stride;
+                (0..FACES as u32 * count * count)
                     .into_par_iter()
-                    .map(|face| {
+                    .map(|k| {
+                        let face = (k / (count * count)) as usize;
+                        let (x, y) = (k % count, (k / count) % count);
                         let mut worst = 0.0f32;
-                        for j in 0..=self.cells {
-                            for i in 0..=self.cells {
+                        for j in y * width..=(y + 1) * width {
+                            for i in x * width..=(x + 1) * width {
                                 let (ci, cj) = (
-                                    (i / stride).min(vertices - 1),
-                                    (j / stride).min(vertices - 1),
+                                    (i / stride).min(self.cells / stride - 1),
+                                    (j / stride).min(self.cells / stride - 1),
                                 );
                                 let (fx, fy) = (
                                     (i - ci * stride) as f32 / stride as f32,
@@ -322,7 +327,7 @@ impl FaceLattice {
                         }
                         worst
                     })
-                    .reduce(|| 0.0, f32::max)
+                    .collect()
             })
             .collect()
     }

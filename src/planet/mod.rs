@@ -100,9 +100,9 @@ pub struct Planet {
     /// Per level 0..=precomputed_level, per patch (face, then row-major): lowest and highest height of the
     /// patch's points, border included.
     bounds: Vec<Vec<(f32, f32)>>,
-    /// Per level 0..precomputed_level: how far the precomputed lattice stands from a patch of that level's
-    /// bilinear surface at most (`FaceLattice::level_deviations`).
-    deviations: Vec<f32>,
+    /// Per level 1..=precomputed_level (index level - 1), per patch: how far the precomputed lattice stands from
+    /// its parent's bilinear surface over the patch at most (`FaceLattice::quadrant_deviations`).
+    quadrant_deviations: Vec<Vec<f32>>,
     pub mountains: Vec<Mountain>,
     pub features: Option<FeaturePoints>,
     /// The rivers and lakes of the drainage model (`None` for the thesis's model).
@@ -299,7 +299,8 @@ impl Planet {
     ) -> Self {
         stats.mountains = mountains.len();
         let bounds = lattice.patch_bounds_pyramid(precomputed_level, config.rendering.vertices);
-        let deviations = lattice.level_deviations(precomputed_level, config.rendering.vertices);
+        let quadrant_deviations =
+            lattice.quadrant_deviations(precomputed_level, config.rendering.vertices);
         stats.memory_bytes = lattice.bytes();
         log::info!("planet: {stats:?}");
         Self {
@@ -311,7 +312,7 @@ impl Planet {
             precomputed_level,
             rule,
             bounds,
-            deviations,
+            quadrant_deviations,
             mountains,
             features,
             drainage,
@@ -321,11 +322,33 @@ impl Planet {
 
     /// The geometric error of a patch of `level` (beyond the thesis, for screen-space-error level of detail): how
     /// far its surface can stand from the finest surface, vertically, plus how far its flat triangles stand
-    /// inside the sphere. Below the precomputed level, the measured deviation from the precomputed lattice plus
-    /// what finer levels add; from it on, what finer levels add (`DetailRule::remaining_range`, a bound). The
-    /// chord's sagitta is `s^2 / (8 radius)` for the vertex spacing `s` along a face.
+    /// inside the sphere, anywhere on the planet: the largest [`Planet::quadrant_error`] of its children.
     pub fn geometric_error(&self, level: u32) -> f64 {
-        let detail = match self.deviations.get(level as usize) {
+        let deviation = self
+            .quadrant_deviations
+            .get(level as usize)
+            .map(|d| d.iter().copied().fold(0.0f32, f32::max));
+        self.error_with(level, deviation)
+    }
+
+    /// The geometric error of drawing `patch`'s parent over `patch`'s area (beyond the thesis, for the
+    /// screen-space rule's error field): below the precomputed level, the measured deviation of the precomputed
+    /// lattice from the parent's bilinear surface there plus what finer levels add; from it on, what finer levels
+    /// add (`DetailRule::remaining_range`, a bound, the same everywhere). Plus the sagitta of the parent's chords.
+    pub fn quadrant_error(&self, patch: PatchId) -> f64 {
+        let level = patch.level as u32 - 1;
+        let deviation = self.quadrant_deviations.get(level as usize).map(|d| {
+            let count = 1usize << patch.level;
+            d[(patch.face as usize * count + patch.y as usize) * count + patch.x as usize]
+        });
+        self.error_with(level, deviation)
+    }
+
+    /// The error of a patch of `level` whose surface stands `deviation` from the precomputed lattice (`None` from
+    /// the precomputed level on): that, what finer levels add, and the sagitta `s^2 / (8 radius)` of a chord of
+    /// the vertex spacing `s` along a face.
+    fn error_with(&self, level: u32, deviation: Option<f32>) -> f64 {
+        let detail = match deviation {
             Some(d) => d + self.rule.remaining_range(self.precomputed_level),
             None => self.rule.remaining_range(level),
         } as f64;

@@ -2,8 +2,11 @@
 //! level's switch distance, which comes from Eq. 6.1 (the thesis) or from the level's geometric error projected to
 //! a number of pixels (screen-space error, beyond the thesis).
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
+use super::error_field::ErrorField;
 use crate::planet::{
     cube::{angle, PatchId, FACES},
     Planet,
@@ -35,14 +38,22 @@ pub fn river_error(spacing: f64, influence_distance: f64, widest: f64) -> f64 {
     }
 }
 
-/// The parameters of the selection: the switch distance of every level.
+/// The parameters of the selection: the switch distance of every patch.
 #[derive(Clone, Debug)]
 pub struct LodParams {
     /// The planet's radius: distances are measured to patches on this sphere.
     pub radius: f64,
-    /// Per level 0..=max_level: the distance below which a patch of that level is refined (visited).
-    pub thresholds: Vec<f64>,
     pub max_level: u32,
+    switch: Switch,
+}
+
+/// Where switch distances come from.
+#[derive(Clone, Debug)]
+enum Switch {
+    /// Per level 0..=max_level: the distance below which a patch of that level is refined (visited).
+    Levels(Vec<f64>),
+    /// The error field's corner values times the pixels' distance per unit of error.
+    Field { errors: Arc<ErrorField>, scale: f64 },
 }
 
 impl LodParams {
@@ -50,46 +61,67 @@ impl LodParams {
     pub fn distance(radius: f64, switch_factor: f64, max_level: u32) -> Self {
         Self {
             radius,
-            thresholds: (0..=max_level)
-                .map(|level| threshold(radius, switch_factor, level))
-                .collect(),
             max_level,
+            switch: Switch::Levels(
+                (0..=max_level)
+                    .map(|level| threshold(radius, switch_factor, level))
+                    .collect(),
+            ),
         }
     }
 
-    /// Screen-space error (beyond the thesis): a patch of level L is refined (its children visited) while its
-    /// geometric error `error(L)` would cover more than `pixels` pixels, i.e. while a child is nearer than
-    /// `error(L) x pixels_per_radian / pixels`, where `pixels_per_radian` is the viewport height over
-    /// 2 tan(fov_y / 2). A level's distance is raised where needed to at least twice the next finer one's, as Eq.
-    /// 6.1's halve: a child's range then lies inside its parent's, so patches meet only patches one level apart
-    /// and morph bands stay inside their level's range, and no patch is drawn with more than `pixels` of error.
+    /// Screen-space error (beyond the thesis): a patch is visited while the error its parent would show over it
+    /// (`errors`, nested so that a child's range lies inside its parent's and patches meet only patches one level
+    /// apart) would cover more than `pixels` pixels, i.e. while it is nearer than
+    /// `error x pixels_per_radian / pixels`, where `pixels_per_radian` is the viewport height over
+    /// 2 tan(fov_y / 2). No patch is then drawn with more than `pixels` of error.
     pub fn screen_space(
         radius: f64,
-        error: impl Fn(u32) -> f64,
+        errors: Arc<ErrorField>,
         pixels_per_radian: f64,
         pixels: f64,
         max_level: u32,
     ) -> Self {
-        // The roots are always drawn; a child of level L is visited by its parent's (level L - 1) error.
-        let mut thresholds: Vec<f64> = (0..=max_level)
-            .map(|level| match level {
-                0 => f64::INFINITY,
-                _ => error(level - 1) * pixels_per_radian / pixels,
-            })
-            .collect();
-        for level in (1..max_level as usize).rev() {
-            thresholds[level] = thresholds[level].max(2.0 * thresholds[level + 1]);
-        }
         Self {
             radius,
-            thresholds,
             max_level,
+            switch: Switch::Field {
+                errors,
+                scale: pixels_per_radian / pixels,
+            },
         }
     }
 
-    /// The switch distance of `level`.
-    pub fn threshold(&self, level: u32) -> f64 {
-        self.thresholds[level.min(self.max_level) as usize]
+    /// The switch distances at `patch`'s corners (0,0), (1,0), (0,1), (1,1); bilinear across the patch, they are
+    /// where its vertices are fully morphed into the parent's mesh.
+    pub fn switch_distances(&self, patch: PatchId) -> [f64; 4] {
+        let level = (patch.level as u32).min(self.max_level);
+        match &self.switch {
+            Switch::Levels(t) => [t[level as usize]; 4],
+            Switch::Field { errors, scale } => errors.corners(patch).map(|e| e * scale),
+        }
+    }
+
+    /// The distance below which `patch` is visited: the largest of its corners' switch distances, so that where
+    /// it is not visited, every point of it lies beyond the switch distance there.
+    pub fn threshold(&self, patch: PatchId) -> f64 {
+        self.switch_distances(patch).into_iter().fold(0.0, f64::max)
+    }
+
+    /// The smallest switch distance over `patch`: a vertex nearer than it is not fully morphed.
+    pub fn nearest_switch(&self, patch: PatchId) -> f64 {
+        self.switch_distances(patch)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The largest switch distance of `level` anywhere (the same everywhere for Eq. 6.1).
+    pub fn level_threshold(&self, level: u32) -> f64 {
+        let level = level.min(self.max_level);
+        match &self.switch {
+            Switch::Levels(t) => t[level as usize],
+            Switch::Field { errors, scale } => errors.worst(level) * scale,
+        }
     }
 }
 
@@ -168,7 +200,7 @@ fn visit(
     let mut quadrants = 0u8;
     for q in 0..4 {
         let child = patch.child(q);
-        if distance(child) < params.threshold(child.level as u32) {
+        if distance(child) < params.threshold(child) {
             visit(child, params, distance, out);
         } else {
             quadrants |= 1 << q;
@@ -181,7 +213,7 @@ fn visit(
 
 /// Whether `patch` is close enough to be visited (Eq. 6.1's distance to its centre).
 pub fn refines(patch: PatchId, camera: DVec3, params: &LodParams) -> bool {
-    centre_distance(patch, camera, params.radius) < params.threshold(patch.level as u32)
+    centre_distance(patch, camera, params.radius) < params.threshold(patch)
 }
 
 /// Eq. 6.1's distance: from the camera to the patch centre projected onto the sphere.

@@ -5,5 +5,6 @@ pub mod cache;
 pub mod camera;
 pub mod camera_path;
 pub mod cull;
+pub mod error_field;
 pub mod lod;
 pub mod surface;

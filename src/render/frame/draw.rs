@@ -96,25 +96,28 @@ impl Drawn {
 }
 
 impl Renderer<'_> {
-    /// A patch's morph parameters (std430 `morph` of the instance): where its vertices start morphing, one over
-    /// the morph band's length, and its texel offset in its parent's river texture. A patch is selected only
-    /// while its nearest point is within its level's switch distance, so every vertex of one that is about to
-    /// appear or disappear is at least that far away: fully morphed, it looks like its parent.
-    fn morph(&self, patch: PatchId) -> [f32; 4] {
+    /// A patch's morph parameters (std430 `morph` of the instance: where in the switch distance its vertices start
+    /// morphing, one over the morph band's share, and its texel offset in its parent's river texture) and its
+    /// corners' switch distances (`switch_distances`). A patch is selected only while its nearest point is within
+    /// its largest switch distance, so every vertex of one that is about to appear or disappear is beyond the
+    /// switch distance at its place: fully morphed, it looks like its parent.
+    fn morph(&self, patch: PatchId) -> ([f32; 4], [f32; 4]) {
         if !self.morphing || patch.level == 0 {
-            return NO_MORPH;
+            return (NO_MORPH, [1.0; 4]);
         }
-        let end = self.lod.threshold(patch.level as u32);
         let half = (self.config.rendering.vertices - 1) / 2;
-        [
-            (end * (1.0 - MORPH_BAND)) as f32,
-            (1.0 / (end * MORPH_BAND)) as f32,
-            ((patch.x & 1) * half) as f32,
-            ((patch.y & 1) * half) as f32,
-        ]
+        (
+            [
+                (1.0 - MORPH_BAND) as f32,
+                (1.0 / MORPH_BAND) as f32,
+                ((patch.x & 1) * half) as f32,
+                ((patch.y & 1) * half) as f32,
+            ],
+            self.lod.switch_distances(patch).map(|d| d as f32),
+        )
     }
 
-    /// Beyond the thesis: whether a vertex of `patch` can lie beyond its level's switch distance. There it is fully
+    /// Beyond the thesis: whether a vertex of `patch` can lie beyond the switch distance at its place. There it is fully
     /// morphed beside partly morphed neighbours, and the grid triangles between them have their corners on one grid
     /// line: thin walls over the step between the two morph factors' heights, which face away from the camera as
     /// often as not and must not be culled, or a pixel they alone cover shows through (docs/rendering.md, "Back
@@ -128,7 +131,7 @@ impl Renderer<'_> {
         let outer = self.planet.radius + hi.abs().max(lo.abs());
         let centre = patch.center() * (self.planet.radius + 0.5 * (lo + hi));
         let reach = outer * patch.cap_angle() + 0.5 * (hi - lo);
-        camera.distance(centre) + reach >= self.lod.threshold(patch.level as u32)
+        camera.distance(centre) + reach >= self.lod.nearest_switch(patch)
     }
 
     /// The visible patches drawn from an ancestor's data, each with how far its surface can lie from the true one:
@@ -187,7 +190,7 @@ impl Renderer<'_> {
             };
             // Morphing towards the parent, whose river data the vertices blend into (its base heights are the
             // patch's own at the points that remain).
-            let morph = self.morph(s.patch);
+            let (morph, switch_distances) = self.morph(s.patch);
             let parent_river = match (source == s.patch, s.patch.parent()) {
                 (true, Some(parent)) if self.morphing => self
                     .cache
@@ -202,6 +205,7 @@ impl Renderer<'_> {
             let wet = data.river.is_some() || data.height_range.0 < self.planet.sea_level;
             let mut instance = instance(s, source, data, camera.position, radius, n);
             instance.morph = morph;
+            instance.switch_distances = switch_distances;
             instance.slots[3] = parent_river;
             instance.tex_rect[3] =
                 SKIRT_SPACINGS * instance.centre_dir[3] + skirt_deficit(s.patch, &stand_ins);

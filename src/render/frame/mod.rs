@@ -14,7 +14,7 @@ mod stats;
 mod upload;
 mod vertex_cache;
 
-use std::{collections::BTreeMap, time::Instant};
+use std::{collections::BTreeMap, sync::Arc, time::Instant};
 
 use glam::DVec3;
 
@@ -45,6 +45,7 @@ use crate::{
         cache::PatchCache,
         camera::Camera,
         cull::HeightRange,
+        error_field::ErrorField,
         lod::{LodParams, Selected},
     },
     shaders,
@@ -123,9 +124,9 @@ pub struct Renderer<'w> {
     frozen: Option<Vec<Selected>>,
     /// This frame's switch distances (`lod_rule`, the camera and the viewport).
     lod: LodParams,
-    /// Per level, the error the screen-space rule projects: the terrain's (`Planet::geometric_error`) or what
-    /// the level's river data can miss (`lod::river_error`), whichever is larger.
-    level_errors: Vec<f64>,
+    /// The errors the screen-space rule projects, patch by patch: the terrain's (`Planet::quadrant_error`) or
+    /// what the parent level's river data can miss (`lod::river_error`), whichever is larger.
+    errors: Arc<ErrorField>,
     /// GPU milliseconds per new patch (base heights and river data), averaged over recent frames: what the
     /// generation budget divides by.
     generation_ms_per_patch: Option<f64>,
@@ -300,7 +301,7 @@ impl<'w> Renderer<'w> {
                 config.rendering.level_of_detail_switch_factor as f64,
                 config.rendering.max_level_of_detail,
             ),
-            level_errors: plan::level_errors(planet, network, config),
+            errors: Arc::new(plan::error_field(planet, network, config)),
             lod_rule: config.rendering.level_of_detail_rule,
             generation_ms_per_patch: None,
             variant: KernelVariant::Tiled,

@@ -15,27 +15,35 @@ use crate::{
     runtime::{
         camera::Camera,
         cull::{visible_quadrants, Frustum, HeightRange},
+        error_field::ErrorField,
         lod::{river_error, select, select_nearest, surface_bounds, LodParams, Selected},
     },
 };
 
-/// Per level 0..=max-level-of-detail, the error the screen-space rule projects: the terrain's geometric error or
-/// what the level's river data can miss, whichever is larger. The patch frame's vertex spacing is the face's
-/// width (2 radii) over the level's vertices.
-pub(super) fn level_errors(planet: &Planet, network: &RiverNetwork, config: &Config) -> Vec<f64> {
+/// The errors the screen-space rule projects (`ErrorField`): for a patch, the terrain's geometric error of its
+/// parent over its area, or what its parent level's river data can miss, whichever is larger. The patch frame's
+/// vertex spacing is the face's width (2 radii) over the level's vertices.
+pub(super) fn error_field(planet: &Planet, network: &RiverNetwork, config: &Config) -> ErrorField {
     let widest = network.widest();
     let segments = (config.rendering.vertices - 1) as f64;
-    (0..=config.rendering.max_level_of_detail)
-        .map(|level| {
-            let spacing = 2.0 * planet.radius / (segments * (1u64 << level) as f64);
-            let rivers = river_error(spacing, network.influence_distance, widest);
-            planet.geometric_error(level).max(rivers)
-        })
-        .collect()
+    let rivers = |level: u32| {
+        let spacing = 2.0 * planet.radius / (segments * (1u64 << level) as f64);
+        river_error(spacing, network.influence_distance, widest)
+    };
+    ErrorField::new(
+        config.rendering.max_level_of_detail,
+        planet.precomputed_level,
+        |patch| {
+            planet
+                .quadrant_error(patch)
+                .max(rivers(patch.level as u32 - 1))
+        },
+        |level| planet.geometric_error(level - 1).max(rivers(level - 1)),
+    )
 }
 
 impl Renderer<'_> {
-    /// The switch distances of this frame: Eq. 6.1, or the levels' errors (terrain or river data, `level_errors`)
+    /// The switch distances of this frame: Eq. 6.1, or the error field (terrain or river data, `error_field`)
     /// projected to `pixel-error` pixels of a viewport `viewport_height` pixels high seen through `camera`.
     pub(super) fn lod_params(&self, camera: &Camera, viewport_height: u32) -> LodParams {
         let r = &self.config.rendering;
@@ -48,7 +56,7 @@ impl Renderer<'_> {
             ),
             LodRule::ScreenSpaceError => LodParams::screen_space(
                 radius,
-                |level| self.level_errors[level as usize],
+                self.errors.clone(),
                 viewport_height as f64 / (2.0 * (0.5 * camera.fov_y).tan()),
                 r.pixel_error as f64,
                 r.max_level_of_detail,

@@ -104,6 +104,7 @@ pub(super) fn instance(
             -1,
         ],
         morph: NO_MORPH,
+        switch_distances: [1.0; 4],
         detail: [
             (centre.x * radius).rem_euclid(DETAIL_PERIOD) as f32,
             (centre.y * radius).rem_euclid(DETAIL_PERIOD) as f32,
@@ -120,5 +121,6 @@ pub(super) fn instance(
 /// on config/earth.xml), under terrain that does not.
 const DETAIL_PERIOD: f64 = 256.0;
 
-/// Morph distances that never morph (the level-0 patches, and the thesis's instant switching).
-pub(super) const NO_MORPH: [f32; 4] = [f32::MAX, 1.0, 0.0, 0.0];
+/// Morph parameters that never morph (the level-0 patches, and the thesis's instant switching): a band of no
+/// length beyond any distance.
+pub(super) const NO_MORPH: [f32; 4] = [f32::MAX, 0.0, 0.0, 0.0];
