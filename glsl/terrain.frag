@@ -40,16 +40,18 @@ float periodicNoise(vec3 x, float period) {
 }
 
 // Beyond the thesis (terrain close up): detail below the vertex spacing, three octaves of value noise from one
-// world unit down to 1/16, each fading out where its cells shrink below about a pixel, so the ground keeps detail at a few
-// units (metres on config/earth.xml) and a distant fragment computes none. In [0, 1], 0.5 where nothing shows.
+// world unit down to 1/16, each fading out while its cells shrink from about four pixels to two (smaller cells
+// alias: they sparkle as the camera moves), so the ground keeps detail at a few units (metres on
+// config/earth.xml) and a distant fragment computes none. In [0, 1], 0.5 where nothing shows.
 // Coordinates: fDetail, the world position modulo DETAIL_PERIOD (precise near the camera at any planet size).
 float groundDetail() {
+    // About 1.4 to 2 pixels' size on the surface.
     float footprint = length(fwidth(fDetail));
     float sum = 0.0;
     float amplitude = 1.0;
     float size = 1.0;
     for (int k = 0; k < 3; ++k) {
-        float fade = 1.0 - smoothstep(0.5, 1.5, footprint / size);
+        float fade = 1.0 - smoothstep(0.35, 0.7, footprint / size);
         if (fade <= 0.0) break;
         sum += amplitude * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
         amplitude *= 0.6;
