@@ -138,6 +138,10 @@ vec3 throughAir(vec3 colour) {
     return colour * fTransmittance + toneMap(fInscatter);
 }
 
+// The share of the foam band that the ripples leave foam in, on average (the foam's value where they are too
+// small to see).
+const float FOAM_COVER = 0.15;
+
 // Beyond the thesis: the lit colour and opacity of water, flowing unless still (the thesis's, Section 8.4): the
 // rippled normal, foam at the bank (rivers) or the shore (the sea) broken up by the moving ripples, the reflected
 // sky, the sun's glint. `q`: the fragment in ripple sizes, `visible`: how much the ripples show (both from
@@ -151,14 +155,15 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
     float edge = stillWater() ? 0.0
                : river ? smoothstep(0.7, 1.0, abs(fRiver.z) / fRiver.w)
                        : 1.0 - smoothstep(0.0, 0.25 * frame.extra.z, depth);
-    // Ripples and foam only where they show (distant and open water skip the noise).
+    // Ripples only where they show (distant water skips the noise); the foam, broken up by the ripples, fades to
+    // its average cover where they are smaller than a pixel (else the banks sparkle in the distance).
     vec3 surface = up;
-    float foam = 0.0;
-    if (visible > 0.0 || edge > 0.0) {
+    float foam = edge * FOAM_COVER;
+    if (visible > 0.0) {
         vec4 r0 = ripple(q0);
         vec4 r1 = ripple(q1);
-        if (visible > 0.0) surface = flowingNormal(up, r0, r1, w0, 0.35 * visible);
-        foam = edge * smoothstep(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w);
+        surface = flowingNormal(up, r0, r1, w0, 0.35 * visible);
+        foam = edge * mix(FOAM_COVER, smoothstep(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible);
     }
     vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
     colour = mix(colour, vec3(0.92, 0.95, 0.97), foam * 0.85);

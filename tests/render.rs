@@ -539,3 +539,34 @@ fn the_vertex_cache_draws_what_the_vertex_shaders_compute() {
     }
     common::assert_no_validation_errors(ctx);
 }
+
+/// Distant river banks do not sparkle: where the ripples are smaller than a pixel, the foam that they break up
+/// takes its average cover instead of pixel-sized flecks (frame 250 of the approach, low over wide rivers).
+#[test]
+fn distant_river_banks_show_no_pixel_sized_foam() {
+    let Some(ctx) = common::gpu() else { return };
+    let size = [640, 360];
+    let flight = Flight::new(world(), 300, 1.0, size[0] as f64 / size[1] as f64);
+    let image = render(ctx, &flight.camera(world(), 250), size, WaterMode::Auto);
+    image.save(out_dir().join("banks-far.png")).unwrap();
+    let (w, h) = image.dimensions();
+    // Flecks: pixels far brighter than each of their four neighbours, in the ground's upper half (far away).
+    let b = |x: u32, y: u32| brightness(image.get_pixel(x, y));
+    let flecks = (h * 2 / 5..h * 7 / 10)
+        .flat_map(|y| (1..w - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)]
+                .iter()
+                .all(|&(u, v)| b(x, y) > b(u, v) + 15.0)
+        })
+        .count();
+    assert!(
+        flecks < MAX_FLECKS,
+        "{flecks} pixel-sized flecks of foam far away (at most {MAX_FLECKS})"
+    );
+    common::assert_no_validation_errors(ctx);
+}
+
+/// Isolated bright pixels the far ground and water of that view may show (1 now; 18 when the foam kept the
+/// ripples' pattern at any size).
+const MAX_FLECKS: usize = 6;
