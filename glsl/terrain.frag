@@ -158,13 +158,14 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
     // Ripples only where they show (distant water skips the noise); the foam, broken up by the ripples, fades to
     // its average cover where they are smaller than a pixel (else the banks sparkle in the distance).
     vec3 surface = up;
-    float foam = edge * FOAM_COVER;
+    float cover = FOAM_COVER;
     if (visible > 0.0) {
         vec4 r0 = ripple(q0);
         vec4 r1 = ripple(q1);
         surface = flowingNormal(up, r0, r1, w0, 0.35 * visible);
-        foam = edge * mix(FOAM_COVER, smoothstep(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible);
+        cover = mix(FOAM_COVER, smoothstep(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible);
     }
+    float foam = edge * cover;
     vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
     colour = mix(colour, vec3(0.92, 0.95, 0.97), foam * 0.85);
     vec3 diffuse = max(dot(surface, sun), 0.0) * fSunlight;

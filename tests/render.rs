@@ -550,7 +550,7 @@ fn distant_river_banks_show_no_pixel_sized_foam() {
     let image = render(ctx, &flight.camera(world(), 250), size, WaterMode::Auto);
     image.save(out_dir().join("banks-far.png")).unwrap();
     let (w, h) = image.dimensions();
-    // Flecks: pixels far brighter than each of their four neighbours, in the ground's upper half (far away).
+    // Flecks: pixels 15 levels brighter than each of their four neighbours, in the rows of the far ground.
     let b = |x: u32, y: u32| brightness(image.get_pixel(x, y));
     let flecks = (h * 2 / 5..h * 7 / 10)
         .flat_map(|y| (1..w - 1).map(move |x| (x, y)))
