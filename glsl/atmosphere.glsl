@@ -49,7 +49,7 @@ vec3 sunTransmittance(Air a, float r, float mu) {
     vec3 t = textureLod(patchTextures[int(frame.extra.x)], vec3(uv, 0.0), 0.0).rgb;
     float s = a.bottom / r;
     float horizonMu = -sqrt(max(1.0 - s * s, 0.0));
-    return t * smoothstep(-0.01, 0.01, mu - horizonMu);
+    return t * smoothBand(-0.01, 0.01, mu - horizonMu);
 }
 
 float rayleighPhase(float c) { return 3.0 / (16.0 * PI) * (1.0 + c * c); }
@@ -58,7 +58,9 @@ float rayleighPhase(float c) { return 3.0 / (16.0 * PI) * (1.0 + c * c); }
 float miePhase(float c) {
     float g = MIE_G;
     float g2 = g * g;
-    return 3.0 / (8.0 * PI) * (1.0 - g2) * (1.0 + c * c) / ((2.0 + g2) * pow(1.0 + g2 - 2.0 * g * c, 1.5));
+    // k^1.5 as k sqrt(k): lavapipe runs pow as a logarithm and an exponential per lane.
+    float k = 1.0 + g2 - 2.0 * g * c;
+    return 3.0 / (8.0 * PI) * (1.0 - g2) * (1.0 + c * c) / ((2.0 + g2) * k * sqrt(k));
 }
 
 // Single scattering along a view segment, before the phase functions (they depend on the angle to the sun only,

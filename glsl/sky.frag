@@ -21,7 +21,7 @@ void main() {
     vec3 dir = normalize(vView);
     float c = dot(dir, normalize(frame.sun.xyz));
     vec3 sky = toneMap(inscattered(vRayleigh, vMie, c));
-    float sun = smoothstep(SUN_COS, 1.0 - 0.25 * (1.0 - SUN_COS), c);
+    float sun = smoothBand(SUN_COS, 1.0 - 0.25 * (1.0 - SUN_COS), c);
     sky += sun * vTransmittance * (1.0 - sky);
     // Blend::Transmit: result = sky + clear colour x the air's (grey) transmittance.
     outColor = vec4(sky, dot(vTransmittance, vec3(1.0 / 3.0)) * (1.0 - sun));

@@ -51,7 +51,7 @@ float groundDetail() {
     float amplitude = 1.0;
     float size = 1.0;
     for (int k = 0; k < 3; ++k) {
-        float fade = 1.0 - smoothstep(0.35, 0.7, footprint / size);
+        float fade = 1.0 - smoothBand(0.35, 0.7, footprint / size);
         if (fade <= 0.0) break;
         sum += amplitude * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
         amplitude *= 0.6;
@@ -66,12 +66,12 @@ float groundDetail() {
 vec3 terrainColour(float height, float slope, vec3 detail) {
     float sea = frame.sun.w;
     float h = (height - sea) / frame.extra.z;
-    vec3 c = mix(SAND, DIRT, smoothstep(0.0, 0.6, h));
-    c = mix(c, GRASS, smoothstep(0.4, 1.4, h));
-    c = mix(c, ROCK, smoothstep(6.0, 9.0, h));
-    c = mix(c, SNOW, smoothstep(12.0, 14.5, h));
+    vec3 c = mix(SAND, DIRT, smoothBand(0.0, 0.6, h));
+    c = mix(c, GRASS, smoothBand(0.4, 1.4, h));
+    c = mix(c, ROCK, smoothBand(6.0, 9.0, h));
+    c = mix(c, SNOW, smoothBand(12.0, 14.5, h));
     // Steep slopes show rock (8.3).
-    c = mix(c, ROCK * 0.9, smoothstep(0.55, 0.8, slope));
+    c = mix(c, ROCK * 0.9, smoothBand(0.55, 0.8, slope));
     if (h < 0.0) c = mix(SAND, DIRT * 0.6, clamp(-h / 3.0, 0.0, 1.0));
     return c * (0.7 + 0.6 * detail);
 }
@@ -130,12 +130,13 @@ vec3 flowingNormal(vec3 up, vec4 r0, vec4 r1, float w0, float strength) {
 }
 
 // The air between the eye and the surface: what it lets through plus what it scatters towards the eye (both per
-// vertex, atmosphere.glsl and terrain_interface.glsl); without an atmosphere, a constant haze that grows with distance.
+// vertex, the latter tone-mapped there: atmosphere.glsl and terrain_vertex.glsl); without an atmosphere, a constant
+// haze that grows with distance.
 vec3 throughAir(vec3 colour) {
     if (!atmosphereOn()) {
         return mix(colour, vec3(0.55, 0.65, 0.8), clamp(length(fPosition) / (frame.planet.x * 6.0), 0.0, 0.35));
     }
-    return colour * fTransmittance + toneMap(fInscatter);
+    return colour * fTransmittance + fInscatter;
 }
 
 // The share of the foam band that the ripples leave foam in, on average (the foam's value where they are too
@@ -153,8 +154,8 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
     float w0;
     flowPhases(q, velocity, q0, q1, w0);
     float edge = stillWater() ? 0.0
-               : river ? smoothstep(0.7, 1.0, abs(fRiver.z) / fRiver.w)
-                       : 1.0 - smoothstep(0.0, 0.25 * frame.extra.z, depth);
+               : river ? smoothBand(0.7, 1.0, abs(fRiver.z) / fRiver.w)
+                       : 1.0 - smoothBand(0.0, 0.25 * frame.extra.z, depth);
     // Ripples only where they show (distant water skips the noise); the foam, broken up by the ripples, fades to
     // its average cover where they are smaller than a pixel (else the banks sparkle in the distance).
     vec3 surface = up;
@@ -163,7 +164,7 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
         vec4 r0 = ripple(q0);
         vec4 r1 = ripple(q1);
         surface = flowingNormal(up, r0, r1, w0, 0.35 * visible);
-        cover = mix(FOAM_COVER, smoothstep(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible);
+        cover = mix(FOAM_COVER, smoothBand(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible);
     }
     float foam = edge * cover;
     vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
@@ -185,7 +186,7 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
 vec3 rippleSpace(bool river, out float visible) {
     float size = river ? max(fRiver.w, 0.02) : frame.extra.z;
     vec3 q = fDirection * (frame.planet.x / size);
-    visible = stillWater() ? 0.0 : 1.0 - smoothstep(0.4, 1.2, length(fwidth(q)));
+    visible = stillWater() ? 0.0 : 1.0 - smoothBand(0.4, 1.2, length(fwidth(q)));
     return q;
 }
 
@@ -244,7 +245,7 @@ void main() {
     uint mode = waterMode();
     bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
     float inside = paint && measured && fRiver.w > 0.0
-                 ? 1.0 - smoothstep(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
+                 ? 1.0 - smoothBand(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
     if (inside > 0.0) {
         vec3 water = viewMode() == 2 ? vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse)
                                      : waterSurface(true, 0.5 * frame.extra.z, q, visible, up, view, sun).rgb;

@@ -44,6 +44,13 @@ struct PatchInstance {
     vec4 detail;      // xyz: the patch centre's world position modulo DETAIL_PERIOD (computed in f64)
 };
 
+// smoothstep with the division by the band's width written as a product, so that constant edges fold to one
+// constant factor (lavapipe runs a division per lane, several times slower than a product); the same curve.
+float smoothBand(float e0, float e1, float x) {
+    float t = clamp((x - e0) * (1.0 / (e1 - e0)), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
 // The period of the ground detail's coordinates (render/frame/draw.rs, DETAIL_PERIOD).
 const float DETAIL_PERIOD = 256.0;
 

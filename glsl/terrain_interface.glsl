@@ -13,7 +13,7 @@ layout(location = 1) TERRAIN_IO vec4 ioNormalFlowY;     // the surface normal; t
 layout(location = 2) TERRAIN_IO vec4 ioRiver;           // final height, water height, signed distance, half width
 layout(location = 3) TERRAIN_IO vec4 ioDirectionFlowZ;  // unit direction from the planet centre; the flow's z
 layout(location = 4) TERRAIN_IO vec4 ioDetailSunR;      // world position mod DETAIL_PERIOD; the sunlight's red
-layout(location = 5) TERRAIN_IO vec4 ioInscatterSunG;   // radiance the air scatters towards the eye; sunlight green
+layout(location = 5) TERRAIN_IO vec4 ioInscatterSunG;   // the air's inscattered light (display value); sunlight green
 layout(location = 6) TERRAIN_IO vec4 ioTransmittanceSunB; // the air's transmittance from the eye; sunlight blue
 layout(location = 7) flat TERRAIN_IO vec3 ioFlat;       // river water (1) or not (0), the level, the vertex spacing
 
@@ -26,7 +26,7 @@ struct SurfaceVertex {
     vec3 detail;
     vec3 flow;            // the river's flow: a tangent, unit length where the samples agree
     vec3 sunlight;        // the sunlight that reaches the vertex
-    vec3 inscatter;       // radiance the air scatters towards the eye
+    vec3 inscatter;       // display value of the radiance the air scatters towards the eye
     vec3 transmittance;   // what the air between the eye and the vertex lets through
     bool riverWater;
     float level;

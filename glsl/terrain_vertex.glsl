@@ -172,7 +172,7 @@ TerrainVertex terrainVertex(PatchInstance p, int id) {
 struct VertexShading {
     vec3 normal;
     vec3 sunlight;       // the sunlight that reaches the vertex
-    vec3 inscatter;      // radiance the air scatters towards the eye (phase functions applied)
+    vec3 inscatter;      // display value of the radiance the air scatters towards the eye (toneMap applied)
     vec3 transmittance;  // what the air between the eye and the vertex lets through
 };
 
@@ -197,10 +197,11 @@ VertexShading shadeVertex(PatchInstance p, TerrainVertex v, bool withNormal) {
     s.transmittance = vec3(1.0);
     if (atmosphereOn()) {
         Scattering air = airTo(v.position, v.surface.x, v.direction, s.sunlight);
-        // The phase functions per vertex: the angle between the view ray and the sun changes slowly across a
-        // triangle (and the cache computes them once per grid point, not per drawn vertex).
+        // The phase functions and the tone map per vertex: the angle between the view ray and the sun and the air
+        // in front change slowly across a triangle (and the cache computes them once per grid point, not per
+        // drawn vertex or per pixel).
         float c = dot(normalize(v.position), normalize(frame.sun.xyz));
-        s.inscatter = inscattered(air.rayleigh, air.mie, c);
+        s.inscatter = toneMap(inscattered(air.rayleigh, air.mie, c));
         s.transmittance = air.transmittance;
     }
     return s;
