@@ -476,6 +476,60 @@ fn the_limb_glows_from_orbit_and_space_stays_dark() {
     common::assert_no_validation_errors(ctx);
 }
 
+/// Around a low sun the sky brightens towards it evenly on both sides (the aureole, whose phase functions the
+/// sky computes per pixel near the sun and per dome vertex farther out, blended between 15 and 25 degrees): no
+/// polygon of the dome and no ring where the two meet.
+#[test]
+fn the_aureole_is_round_and_fades_without_a_seam() {
+    let Some(ctx) = common::gpu() else { return };
+    let size = [240, 240];
+    let (eye, target) = presets::camera(Preset::Ground, world()).unwrap();
+    let up = eye.normalize();
+    let ahead = (target - eye).reject_from(up).normalize();
+    let elevation = 6f64.to_radians();
+    let sun = ahead * elevation.cos() + up * elevation.sin();
+    let fov = 90f64;
+    let camera = Camera::look_at(eye, eye + sun, fov, 1.0, 0.1);
+    let image = render_cleared(ctx, &camera, size, [0.0, 0.0, 0.0, 1.0], |r| {
+        r.sun = Some(sun)
+    });
+    image.save(out_dir().join("aureole.png")).unwrap();
+    // Pixels at `degrees` from the sun (the image's centre) towards the left, the right and the top.
+    let focal = size[1] as f64 / 2.0 / (fov.to_radians() / 2.0).tan();
+    let at = |degrees: f64, (dx, dy): (f64, f64)| {
+        let d = focal * degrees.to_radians().tan();
+        let (x, y) = (size[0] as f64 / 2.0 + dx * d, size[1] as f64 / 2.0 + dy * d);
+        brightness(image.get_pixel(x as u32, y as u32))
+    };
+    let directions = [(-1.0, 0.0), (1.0, 0.0)];
+    let angles: Vec<f64> = (0..=36).map(|k| 4.0 + k as f64).collect();
+    for d in directions {
+        let profile: Vec<f64> = angles.iter().map(|&a| at(a, d)).collect();
+        assert!(
+            profile[0] > profile[profile.len() - 1] + 4.0,
+            "no aureole towards {d:?}: {profile:?}"
+        );
+        // A degree farther from the sun is never brighter and never more than a step of 1.5 darker.
+        for (k, pair) in profile.windows(2).enumerate() {
+            assert!(
+                pair[1] <= pair[0] + 0.5 && pair[0] - pair[1] <= 1.5,
+                "towards {d:?} the sky jumps at {} degrees from the sun: {profile:?}",
+                angles[k + 1]
+            );
+        }
+    }
+    for &a in &angles {
+        let ring: Vec<f64> = directions.iter().map(|&d| at(a, d)).collect();
+        let spread = ring.iter().cloned().fold(f64::MIN, f64::max)
+            - ring.iter().cloned().fold(f64::MAX, f64::min);
+        assert!(
+            spread <= 4.0,
+            "at {a} degrees from the sun the sky differs by {spread:.1} around it: {ring:?}"
+        );
+    }
+    common::assert_no_validation_errors(ctx);
+}
+
 /// Beyond the thesis: the water flows. Half a second later the rivers' ripples and foam have moved and nothing
 /// else has; still water (the thesis's) does not change with time.
 #[test]
