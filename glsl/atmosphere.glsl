@@ -129,10 +129,10 @@ Scattering airTo(vec3 position, float height, vec3 up, out vec3 sunlight) {
     return scatter(a, frame.camera.xyz, position / max(distance, 1e-6), distance, SURFACE_STEPS, true);
 }
 
-// Radiance scattered towards the eye, `c` the cosine of the angle between the view ray and the sun.
-vec3 inscattered(vec3 rayleigh, vec3 mie, float c) {
-    return SUN_INTENSITY * (rayleigh * rayleighPhase(c) + mie * miePhase(c));
+// The display value (tone-mapped at exposure 1) of the radiance scattered towards the eye, `c` the cosine of the
+// angle between the view ray and the sun: what every caller draws (surfaces per vertex, the sky per vertex and
+// near the sun per pixel).
+vec3 inscatteredColour(vec3 rayleigh, vec3 mie, float c) {
+    vec3 radiance = SUN_INTENSITY * (rayleigh * rayleighPhase(c) + mie * miePhase(c));
+    return 1.0 - exp(-radiance);
 }
-
-// Display value of scattered radiance (exposure 1).
-vec3 toneMap(vec3 radiance) { return 1.0 - exp(-radiance); }

@@ -30,7 +30,7 @@ void main() {
     float c = dot(dir, normalize(frame.sun.xyz));
     vec3 sky = vSky;
     if (c > AUREOLE_OUTER_COS) {
-        vec3 aureole = toneMap(inscattered(vRayleigh, vMie, c));
+        vec3 aureole = inscatteredColour(vRayleigh, vMie, c);
         sky = mix(vSky, aureole, smoothBand(AUREOLE_OUTER_COS, AUREOLE_INNER_COS, c));
     }
     float sun = smoothBand(SUN_COS, 1.0 - 0.25 * (1.0 - SUN_COS), c);

@@ -22,7 +22,7 @@ void main() {
     vTransmittance = v.transmittance.xyz;
     // The sky's colour with the phase functions of the vertex's own angle to the sun: away from the sun they
     // change slowly across a quad of the dome (sky.frag evaluates them per pixel near it).
-    vSky = toneMap(inscattered(v.rayleigh.xyz, v.mie.xyz, dot(v.direction.xyz, normalize(frame.sun.xyz))));
+    vSky = inscatteredColour(v.rayleigh.xyz, v.mie.xyz, dot(v.direction.xyz, normalize(frame.sun.xyz)));
     // A direction (w = 0) projects to depth 0 with the infinite reversed-Z projection.
     gl_Position = frame.viewProjection * vec4(v.direction.xyz, 0.0);
 }

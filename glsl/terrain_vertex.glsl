@@ -172,7 +172,7 @@ TerrainVertex terrainVertex(PatchInstance p, int id) {
 struct VertexShading {
     vec3 normal;
     vec3 sunlight;       // the sunlight that reaches the vertex
-    vec3 inscatter;      // display value of the radiance the air scatters towards the eye (toneMap applied)
+    vec3 inscatter;      // display value of the radiance the air scatters towards the eye (inscatteredColour)
     vec3 transmittance;  // what the air between the eye and the vertex lets through
 };
 
@@ -201,7 +201,7 @@ VertexShading shadeVertex(PatchInstance p, TerrainVertex v, bool withNormal) {
         // in front change slowly across a triangle (and the cache computes them once per grid point, not per
         // drawn vertex or per pixel).
         float c = dot(normalize(v.position), normalize(frame.sun.xyz));
-        s.inscatter = toneMap(inscattered(air.rayleigh, air.mie, c));
+        s.inscatter = inscatteredColour(air.rayleigh, air.mie, c);
         s.transmittance = air.transmittance;
     }
     return s;
