@@ -79,7 +79,7 @@ vec3 terrainColour(float height, float slope, vec3 detail) {
 vec3 levelColour(float level) {
     vec3 palette[8] = vec3[](vec3(0.9, 0.2, 0.2), vec3(0.9, 0.6, 0.1), vec3(0.9, 0.9, 0.2), vec3(0.3, 0.8, 0.3),
                              vec3(0.2, 0.8, 0.8), vec3(0.2, 0.4, 0.9), vec3(0.6, 0.3, 0.9), vec3(0.9, 0.3, 0.7));
-    return palette[int(level) % 8];
+    return palette[int(level + 0.5) % 8];
 }
 
 // Beyond the thesis (water that flows): ripples of two octaves of value noise, `q` in ripple sizes, carried
@@ -225,9 +225,13 @@ void main() {
     }
     float visible;
     vec3 q = rippleSpace(true, visible);
+    float seaVisible;
+    vec3 seaQ = rippleSpace(false, seaVisible);
     // Derivatives in uniform control flow, before any branch.
     vec2 dz = vec2(dFdx(fRiver.z), dFdy(fRiver.z));
     float edge = abs(dz.x) + abs(dz.y) + 1e-4;
+    float shoreEdge = fwidth(fRiver.x) + 1e-6;
+    float bankEdge = fwidth(fRiver.y - fRiver.x) + 1e-6;
     bool measured = distanceSlope(dz) <= RIVER_SLOPE_LIMIT;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
@@ -244,12 +248,30 @@ void main() {
     // the distance was measured to different rivers (beyond the thesis, distanceSlope).
     uint mode = waterMode();
     bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
-    float inside = paint && measured && fRiver.w > 0.0
-                 ? 1.0 - smoothBand(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
-    if (inside > 0.0) {
-        vec3 water = viewMode() == 2 ? vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse)
-                                     : waterSurface(true, 0.5 * frame.extra.z, q, visible, up, view, sun).rgb;
-        colour = mix(colour, water, inside);
+    float inBasin = fRiver.w > 0.0 ? 1.0 - smoothBand(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
+    float painted = paint && measured ? inBasin : 0.0;
+    // Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the sea and the rivers the mesh shows,
+    // over the terrain's colour as the water pass blends them: where the terrain lies below the water's surface
+    // (what the water pass's depth test decides) and, for a river, within its width (where the water pass cuts
+    // it) on triangles with a vertex in the basin (those the water pass draws); both edges antialiased. The sea
+    // covers a river's mouth.
+    float sea = frame.sun.w;
+    bool inMesh = waterInMesh();
+    float underSea = inMesh ? 1.0 - smoothBand(-shoreEdge, shoreEdge, fRiver.x - sea) : 0.0;
+    float inRiver = inMesh && !paint && fNearBasin > 0.0
+                  ? inBasin * smoothBand(-bankEdge, bankEdge, fRiver.y - fRiver.x) : 0.0;
+    bool seaWater = underSea > 0.0;
+    float cover = seaWater ? underSea : max(inRiver, painted);
+    // One evaluation of the water's surface for whichever water this pixel shows.
+    if (cover > 0.0) {
+        bool paintedWater = !seaWater && painted > 0.0;
+        float depth = seaWater ? sea - fRiver.x : paintedWater ? 0.5 * frame.extra.z : fRiver.y - fRiver.x;
+        vec4 water = waterSurface(!seaWater, max(depth, 0.0), seaWater ? seaQ : q, seaWater ? seaVisible : visible, up,
+                                  view, sun);
+        // Painted rivers are opaque (the thesis's painting).
+        if (paintedWater) water.a = 1.0;
+        if (paintedWater && viewMode() == 2) water.rgb = vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse);
+        colour = mix(colour, water.rgb, water.a * cover);
     }
     outColor = vec4(throughAir(colour), 1.0);
 }

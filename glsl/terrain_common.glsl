@@ -8,8 +8,8 @@ layout(push_constant) uniform FramePush {
     // xyz: unit direction towards the sun; w: sea level.
     vec4 sun;
     // x: radius; y: vertices per patch edge; z: water mode (0 auto, 1 geometry, 2 painted) + 4 x view (0 shaded,
-    // 1 level-of-detail colours, 2 painted rivers shown red) + 16 if the water is still; w: the lowest height any
-    // terrain can have.
+    // 1 level-of-detail colours, 2 painted rivers shown red) + 16 if the water is still + 32 if the water is part
+    // of the terrain mesh; w: the lowest height any terrain can have.
     vec4 planet;
     // x: the atmosphere's transmittance table slot, or -1 without atmosphere; y: time in seconds (the water's
     // flow); z: height unit of the colour bands (max-mountain-height / 16, so that Appendix A's planet, whose
@@ -22,6 +22,9 @@ layout(push_constant) uniform FramePush {
 uint waterMode() { return uint(frame.planet.z) & 3u; }
 uint viewMode() { return (uint(frame.planet.z) >> 2) & 3u; }
 bool stillWater() { return (uint(frame.planet.z) & 16u) != 0u; }
+// Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the terrain pass draws the water, its
+// vertices under water raised to the water's surface; no water pass.
+bool waterInMesh() { return (uint(frame.planet.z) & 32u) != 0u; }
 
 const uint WATER_AUTO = 0;
 const uint WATER_GEOMETRY = 1;

@@ -15,7 +15,9 @@ layout(location = 3) TERRAIN_IO vec4 ioDirectionFlowZ;  // unit direction from t
 layout(location = 4) TERRAIN_IO vec4 ioDetailSunR;      // world position mod DETAIL_PERIOD; the sunlight's red
 layout(location = 5) TERRAIN_IO vec4 ioInscatterSunG;   // the air's inscattered light (display value); sunlight green
 layout(location = 6) TERRAIN_IO vec4 ioTransmittanceSunB; // the air's transmittance from the eye; sunlight blue
-layout(location = 7) flat TERRAIN_IO vec3 ioFlat;       // river water (1) or not (0), the level, the vertex spacing
+// River water (1) or not (0), the level, the vertex spacing: the same at a triangle's three vertices (so
+// interpolated, not flat, to share the slot); whether the vertex lies in a river basin (1) or not (0).
+layout(location = 7) TERRAIN_IO vec4 ioKindLevelSpacingBasin;
 
 // One vertex of what terrain.frag reads.
 struct SurfaceVertex {
@@ -31,6 +33,7 @@ struct SurfaceVertex {
     bool riverWater;
     float level;
     float spacing;
+    bool inBasin;         // |signed distance| < half width
 };
 
 #ifdef TERRAIN_WRITER
@@ -42,7 +45,7 @@ void writeSurface(SurfaceVertex v) {
     ioDetailSunR = vec4(v.detail, v.sunlight.r);
     ioInscatterSunG = vec4(v.inscatter, v.sunlight.g);
     ioTransmittanceSunB = vec4(v.transmittance, v.sunlight.b);
-    ioFlat = vec3(v.riverWater ? 1.0 : 0.0, v.level, v.spacing);
+    ioKindLevelSpacingBasin = vec4(v.riverWater ? 1.0 : 0.0, v.level, v.spacing, v.inBasin ? 1.0 : 0.0);
 }
 #else
 #define fPosition ioPositionFlowX.xyz
@@ -54,7 +57,9 @@ void writeSurface(SurfaceVertex v) {
 #define fSunlight vec3(ioDetailSunR.w, ioInscatterSunG.w, ioTransmittanceSunB.w)
 #define fInscatter ioInscatterSunG.xyz
 #define fTransmittance ioTransmittanceSunB.xyz
-#define fRiverWater ioFlat.x
-#define fLevel ioFlat.y
-#define fSpacing ioFlat.z
+#define fRiverWater ioKindLevelSpacingBasin.x
+#define fLevel ioKindLevelSpacingBasin.y
+#define fSpacing ioKindLevelSpacingBasin.z
+// Above 0 where any vertex of the triangle lies in a river basin (the water pass's choice of river triangles).
+#define fNearBasin ioKindLevelSpacingBasin.w
 #endif

@@ -142,14 +142,30 @@ ivec2 meshGrid(int id, out int edge) {
 // parent's (whose points keep their heights at every level).
 vec2 morphedGrid(vec2 grid, float morph) { return grid - mod(grid, 2.0) * morph; }
 
-// Places a vertex of height `height` at the morphed grid position (offset: directionOffset there); skirts hang
-// texRect.w below.
-void place(PatchInstance p, inout TerrainVertex v, float height) {
+// Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the height at which the mesh places a
+// vertex of `surface` (terrain height, water height, signed distance, half width). With the water in the mesh,
+// a vertex under the sea, or in a river basin whose water the mesh shows (not painted), lies on the water's
+// surface, so that the terrain pass draws the water where it is and writes its depth; else on the terrain. Only
+// the vertex's own data decide, so the vertices patches share are placed alike.
+float placedHeight(vec4 surface) {
+    float height = surface.x;
+    if (!waterInMesh()) return height;
+    height = max(height, frame.sun.w);
+    if (waterMode() != WATER_PAINTED && abs(surface.z) < surface.w) height = max(height, surface.y);
+    return height;
+}
+
+// Places a vertex of `v.surface` at the morphed grid position (offset: directionOffset there), at placedHeight;
+// skirts hang texRect.w below.
+void place(PatchInstance p, inout TerrainVertex v) {
     v.direction = normalize(p.centreDir.xyz + v.offset);
-    if (v.edge >= 0) height -= p.texRect.w;
-    v.surface.x = height;
-    v.position = positionAt(p, height, v.offset);
-    v.local = p.centreDir.xyz * height + v.offset * (frame.planet.x + height);
+    float placed = placedHeight(v.surface);
+    if (v.edge >= 0) {
+        v.surface.x -= p.texRect.w;
+        placed -= p.texRect.w;
+    }
+    v.position = positionAt(p, placed, v.offset);
+    v.local = p.centreDir.xyz * placed + v.offset * (frame.planet.x + placed);
 }
 
 // Mesh vertex `id` of `p`, computed from the patch textures.
@@ -163,7 +179,7 @@ TerrainVertex terrainVertex(PatchInstance p, int id) {
     vec2 flow;
     v.surface = surfaceAt(p, v.morphed, v.morph, flow);
     v.offset = directionOffset(p, v.morphed);
-    place(p, v, v.surface.x);
+    place(p, v);
     v.flow = flowTangent(p, flow, v.direction);
     return v;
 }
@@ -247,7 +263,7 @@ void loadVertex(PatchInstance p, int id, out TerrainVertex v, out VertexShading 
     v.morphed = morphedGrid(v.grid, v.morph);
     v.offset = directionOffset(p, v.morphed);
     v.surface = c.surface;
-    place(p, v, c.surface.x);
+    place(p, v);
     vec2 flowZSunR = unpackHalf2x16(c.shading.y);
     vec2 inscatterBTransmittanceR = unpackHalf2x16(c.air.x);
     v.flow = vec3(unpackHalf2x16(c.shading.x), flowZSunR.x);

@@ -593,7 +593,8 @@ fn a_region_exports_as_a_georeferenced_raster_and_as_a_gltf_mesh_at_the_same_hei
 /// The exports' surface is the renderer's: close above the first river (the `river` preset), every grid vertex
 /// the terrain pass draws unmorphed (captured from the vertex shader) lies at the height `runtime::surface` gives
 /// its patch's grid point on the CPU (the exports' source), within a thousandth of a unit (f32 positions relative
-/// to the camera, and the blend's rounding on two sides).
+/// to the camera, and the blend's rounding on two sides): the terrain, or with the water in the mesh (the default)
+/// the water's surface where the vertex lies under water (`CarvedPatch::placed`).
 #[test]
 fn the_exported_surface_is_the_surface_the_renderer_draws() {
     let Some(ctx) = common::gpu() else { return };
@@ -631,21 +632,26 @@ fn the_exported_surface_is_the_surface_the_renderer_draws() {
     let radius = world.planet.radius;
     let mut worst = 0.0f64;
     let mut carved = 0;
+    let mut under_water = 0;
+    let sea_level = world.planet.sea_level;
     for v in &unmorphed {
         let drawn = (capture.camera + v.relative).length() - radius;
         let surface = &surfaces[&v.patch];
         let index = (v.j * n + v.i) as usize;
-        let exported = surface.terrain[index] as f64;
+        let exported = surface.placed(index, sea_level) as f64;
         worst = worst.max((drawn - exported).abs());
         carved += usize::from(surface.basin[index] > -world.config.river.influence_distance);
+        under_water += usize::from(exported > surface.terrain[index] as f64);
     }
     println!(
-        "{} unmorphed vertices of {} patches ({carved} within a river's reach): largest difference {worst}",
+        "{} unmorphed vertices of {} patches ({carved} within a river's reach, {under_water} under water): largest \
+         difference {worst}",
         unmorphed.len(),
         patches.len()
     );
     assert!(unmorphed.len() > 5_000, "only {} vertices", unmorphed.len());
     assert!(carved > 1_000, "only {carved} vertices near rivers");
+    assert!(under_water > 100, "only {under_water} vertices under water");
     assert!(
         worst < 1e-3,
         "the renderer draws {worst} away from the export"

@@ -117,6 +117,7 @@ pub struct FlightReport {
     pub frames_in_flight: usize,
     pub atmosphere: bool,
     pub vertex_cache: bool,
+    pub water_in_mesh: bool,
     pub lod_rule: crate::config::LodRule,
     pub river_model: crate::config::RiverModel,
     pub radius: f64,
@@ -162,6 +163,8 @@ pub struct FlightOptions {
     pub atmosphere: bool,
     /// The vertex cache (`false`: vertices computed in the vertex shaders, as the thesis).
     pub vertex_cache: bool,
+    /// The water drawn by the terrain pass (`false`: the thesis's water pass).
+    pub water_in_mesh: bool,
 }
 
 impl FlightOptions {
@@ -208,6 +211,7 @@ fn fly(
     renderer.parent_reuse = options.parent_reuse;
     renderer.atmosphere_on = options.atmosphere;
     renderer.cache_vertices = options.vertex_cache;
+    renderer.water_in_mesh = options.water_in_mesh;
     renderer.set_frames_in_flight(options.frames_in_flight)?;
     renderer.lod_rule = options.rule(config);
     // Each frame's kernel input, to rerun through every variant.
@@ -502,6 +506,7 @@ pub fn flight_bench(
         morphing: options.morphing,
         atmosphere: options.atmosphere,
         vertex_cache: options.vertex_cache,
+        water_in_mesh: options.water_in_mesh,
         parent_reuse: options.parent_reuse,
         frames_in_flight: options.frames_in_flight,
         lod_rule: options.rule(&config),

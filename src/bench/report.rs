@@ -337,24 +337,26 @@ fn frame_section(w: &mut String, paths: &[std::path::PathBuf]) -> Result<(), Plo
         "## The frame on the default planet\n\nBeyond the thesis: the scripted approach on config/planet.xml at the \
          resolution given, in the default water mode, with each level-of-detail rule (`screen-space-error`, the \
          default; `distance`, the thesis's Eq. 6.1), number of frames in flight, the atmosphere on (the \
-         default) or off, and the vertex cache on (the default) or off (the thesis's vertex shaders). Frame times \
-         are wall-clock per frame, waits for the GPU included.\n\n\
-         | report | level of detail | frames in flight | atmosphere | vertex cache | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) | vertex cache pass ms (GPU) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|"
+         default) or off, the vertex cache on (the default) or off (the thesis's vertex shaders), and the water in \
+         the terrain mesh (the default) or in the thesis's water pass. Frame times are wall-clock per frame, waits \
+         for the GPU included.\n\n\
+         | report | level of detail | frames in flight | atmosphere | vertex cache | water in the mesh | frames | terrain triangles per frame | frame ms mean | frame ms median | terrain pass ms (GPU) | vertex cache pass ms (GPU) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for path in paths {
         let d = read_report(path, "bench flight", "summary")?;
         let s = &d["summary"];
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} | {:.1} |",
+            "| {} | {} | {} | {} | {} | {} | {} at {}x{} | {:.0} | {:.1} | {:.1} | {:.1} | {:.1} |",
             path.file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
             d["lod_rule"].as_str().unwrap_or("?"),
             d["frames_in_flight"],
-            // Reports from before the atmosphere or the vertex cache had none.
+            // Reports from before the atmosphere, the vertex cache or the water in the mesh had none.
             on_off(&d["atmosphere"]),
             on_off(&d["vertex_cache"]),
+            on_off(&d["water_in_mesh"]),
             s["frames"],
             d["resolution"][0],
             d["resolution"][1],

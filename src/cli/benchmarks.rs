@@ -95,6 +95,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             frames,
             atmosphere,
             vertex_cache,
+            water_in_mesh,
             speed,
             size,
             no_kernel_comparison,
@@ -146,6 +147,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 frames_in_flight,
                 atmosphere: atmosphere.on(),
                 vertex_cache: vertex_cache.on(),
+                water_in_mesh: water_in_mesh.on(),
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
                 if let Some(bar) = &bar {

@@ -165,6 +165,10 @@ pub struct RenderArgs {
     /// thesis's still water.
     #[arg(long, value_enum, default_value = "on")]
     pub flowing_water: Switch,
+    /// The water drawn by the terrain pass, its vertices under water raised to the water's surface (beyond the
+    /// thesis). `off`: the thesis's water pass of transparent triangles over the terrain.
+    #[arg(long, value_enum, default_value = "on")]
+    pub water_in_mesh: Switch,
     /// Put the sun this many degrees above the camera's horizon, straight ahead (-90 to 90; 3 is a sunset)
     /// [default: over the camera's shoulder].
     #[arg(long, value_parser = parse_elevation, allow_hyphen_values = true)]
@@ -203,6 +207,10 @@ pub struct ViewArgs {
     /// thesis's still water.
     #[arg(long, value_enum, default_value = "on")]
     pub flowing_water: Switch,
+    /// The water drawn by the terrain pass, its vertices under water raised to the water's surface (beyond the
+    /// thesis). `off`: the thesis's water pass of transparent triangles over the terrain.
+    #[arg(long, value_enum, default_value = "on")]
+    pub water_in_mesh: Switch,
     /// Run this many frames, then exit (with --screenshot, write it first).
     #[arg(long)]
     pub frames: Option<u64>,
@@ -433,6 +441,9 @@ pub enum BenchCommand {
         /// pass; `off`: in the vertex shaders of both passes, as the thesis.
         #[arg(long, value_enum, default_value = "on")]
         vertex_cache: Switch,
+        /// The water drawn by the terrain pass (beyond the thesis); `off`: the thesis's water pass.
+        #[arg(long, value_enum, default_value = "on")]
+        water_in_mesh: Switch,
         /// Camera speed factor (the stress test uses 25).
         #[arg(long, default_value_t = 1.0, value_parser = positive_number, allow_hyphen_values = true)]
         speed: f64,

@@ -68,6 +68,7 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     renderer.morphing = !args.no_morphing;
     renderer.atmosphere_on = args.atmosphere.on();
     renderer.flowing_water = args.flowing_water.on();
+    renderer.water_in_mesh = args.water_in_mesh.on();
     renderer.time = args.time as f32;
     if let Some(elevation) = args.sun_elevation {
         // Straight ahead along the camera's horizon, raised by the elevation.
@@ -206,6 +207,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
             water: args.water,
             atmosphere: args.atmosphere.on(),
             flowing_water: args.flowing_water.on(),
+            water_in_mesh: args.water_in_mesh.on(),
         },
     )?;
     Ok(())

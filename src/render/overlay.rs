@@ -175,6 +175,7 @@ fn panel(egui: &egui::Context, renderer: &mut Renderer, info: &ViewInfo, stats: 
             });
             ui.checkbox(&mut renderer.atmosphere_on, "atmosphere");
             ui.checkbox(&mut renderer.flowing_water, "flowing water");
+            ui.checkbox(&mut renderer.water_in_mesh, "water in the terrain mesh");
             ui.checkbox(&mut renderer.morphing, "morphing");
             ui.checkbox(&mut renderer.wireframe_on, "wireframe");
             let mut lod_colours = renderer.view_mode == ViewMode::Lod;

@@ -115,6 +115,18 @@ impl CarvedPatch {
         bilinear(n - 1, grid, |i, j| values[(j * n + i) as usize])
     }
 
+    /// The height at which the terrain pass places vertex `index` with the water in the mesh (`placedHeight` in
+    /// glsl/terrain_vertex.glsl, for the `auto` and `geometry` water modes): the water's surface under the sea or
+    /// inside a river's basin, else the terrain.
+    pub fn placed(&self, index: usize, sea_level: f32) -> f32 {
+        let height = self.terrain[index].max(sea_level);
+        if self.basin[index] > 0.0 {
+            height.max(self.water[index])
+        } else {
+            height
+        }
+    }
+
     /// The height of what is drawn at direction `d`: the water where the vertices around it are in a river's
     /// basin or the terrain is below sea level, else the terrain.
     pub fn surface(&self, d: DVec3, n: u32, sea_level: f32) -> f32 {

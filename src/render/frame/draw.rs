@@ -329,8 +329,9 @@ impl Renderer<'_> {
         let sets = [self.bindless.set, instance_set];
         let push = bytemuck::bytes_of(&push);
         let scope = self.frames.profiler().begin(rec, "vertices")?;
+        let water_pass = !self.wireframe_on && !self.draws_water_in_mesh(camera);
         self.vertex_cache
-            .record(rec, (&sets, push), &vertex_cache, cached, n);
+            .record(rec, (&sets, push), &vertex_cache, cached, n, water_pass);
         self.frames.profiler().end(rec, scope);
         if let (Some(sky), Some(vertices)) = (&self.sky, &dome_vertices) {
             let scope = self.frames.profiler().begin(rec, "sky dome")?;
@@ -374,7 +375,7 @@ impl Renderer<'_> {
         }
         self.frames.profiler().end(rec, scope);
         let scope = self.frames.profiler().begin(rec, "water")?;
-        if !self.wireframe_on {
+        if water_pass {
             rec.draw_indexed_indirect(
                 &self.cached_water,
                 (&sets, push),

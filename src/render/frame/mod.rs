@@ -141,6 +141,11 @@ pub struct Renderer<'w> {
     /// Beyond the thesis: rippled water carried by the rivers' flow, foam at banks and shores; `false`: still,
     /// flat water as the thesis draws it (Section 8.4).
     pub flowing_water: bool,
+    /// Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the terrain pass draws the water, its
+    /// vertices under the sea or in a river basin the mesh shows raised to the water's surface, and no water pass
+    /// runs; `false`: the thesis's water pass (Section 8.4), transparent triangles over the terrain. From a camera
+    /// under the sea the water pass draws it either way (the raised surface faces away from it).
+    pub water_in_mesh: bool,
     /// Beyond the thesis: the drawn patches' vertices computed once a frame in a compute pass and read by both
     /// passes (render/frame/vertex_cache.rs); `false`: computed in the vertex shaders, as the thesis.
     pub cache_vertices: bool,
@@ -311,6 +316,7 @@ impl<'w> Renderer<'w> {
             freeze_lod: false,
             atmosphere_on: true,
             flowing_water: true,
+            water_in_mesh: true,
             cache_vertices: true,
             time: 0.0,
             morphing: true,

@@ -13,6 +13,12 @@ use crate::{
 
 impl Renderer<'_> {
     /// This frame's push constants for `camera`.
+    /// Whether this frame draws the water in the terrain mesh: `water_in_mesh`, from above the sea.
+    pub(super) fn draws_water_in_mesh(&self, camera: &Camera) -> bool {
+        self.water_in_mesh
+            && camera.position.length() > self.planet.radius + self.planet.sea_level as f64
+    }
+
     pub(super) fn frame_push(&self, camera: &Camera) -> FramePush {
         let radius = self.planet.radius;
         let n = self.config.rendering.vertices;
@@ -39,7 +45,10 @@ impl Renderer<'_> {
             planet: [
                 radius as f32,
                 n as f32,
-                (self.water_mode as u32 + 4 * view_mode + 16 * !self.flowing_water as u32) as f32,
+                (self.water_mode as u32
+                    + 4 * view_mode
+                    + 16 * !self.flowing_water as u32
+                    + 32 * self.draws_water_in_mesh(camera) as u32) as f32,
                 self.heights.min as f32,
             ],
             extra: [

@@ -106,8 +106,9 @@ impl VertexCache {
         })
     }
 
-    /// Records the passes that fill `cache`, then the water indices and draws from it (all bound in `sets`), for
-    /// instances 0 .. `patches`, and makes them visible to the vertex shaders and the indexed indirect draws.
+    /// Records the passes that fill `cache`, then, for a frame with a `water_pass`, the water indices and draws
+    /// from it (all bound in `sets`), for instances 0 .. `patches`, and makes them visible to the vertex shaders and
+    /// the indexed indirect draws.
     pub(super) fn record(
         &self,
         rec: &mut Recorder,
@@ -115,6 +116,7 @@ impl VertexCache {
         cache: &Buffer,
         patches: usize,
         n: u32,
+        water_pass: bool,
     ) {
         if patches == 0 {
             return;
@@ -130,6 +132,9 @@ impl VertexCache {
             &[Access::ComputeWrite],
             &[Access::ComputeRead, Access::VertexShaderRead],
         );
+        if !water_pass {
+            return;
+        }
         rec.dispatch(&self.water_triangles, sets, push, [1, patches as u32, 1]);
         // One barrier for the draws and their indices (lavapipe waits for all earlier work at every barrier).
         rec.memory_barrier(

@@ -82,6 +82,8 @@ pub struct ViewerOptions {
     pub water: super::WaterMode,
     pub atmosphere: bool,
     pub flowing_water: bool,
+    /// The water drawn by the terrain pass (`false`: the thesis's water pass).
+    pub water_in_mesh: bool,
 }
 
 /// Opens the viewer and runs until the window closes (or `frames` are done).
@@ -416,6 +418,7 @@ impl ApplicationHandler for App<'_> {
             renderer.water_mode = self.options.water;
             renderer.atmosphere_on = self.options.atmosphere;
             renderer.flowing_water = self.options.flowing_water;
+            renderer.water_in_mesh = self.options.water_in_mesh;
         }
         if let Err(e) = self.recreate_swapchain() {
             self.fail(event_loop, e);
