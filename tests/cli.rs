@@ -214,6 +214,48 @@ fn the_ground_preset_reaches_deep_levels_made_on_demand() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `render`'s near plane follows the camera's height above the surface below it, not above the radius: two metres
+/// above an Earth-sized river in a valley hundreds of metres up, a near plane from the radius (10 m) clipped the
+/// water in front of the camera, and the image's lower half showed what lies behind it (without the atmosphere,
+/// the clear colour: 2,495 pixels of 7,200).
+#[test]
+fn render_draws_the_water_in_front_of_a_camera_close_above_high_ground() {
+    let dir = temp_dir("near");
+    let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml");
+    let out = dir.join("ground.png");
+    let run = riverplanet()
+        .args([
+            "render",
+            "--preset",
+            "ground",
+            "--size",
+            "160x90",
+            "--atmosphere",
+            "off",
+        ])
+        .args(["--clear-color", "1,0,1", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let image = image::open(&out).unwrap().to_rgb8();
+    let clear = (45..90)
+        .flat_map(|y| (0..160).map(move |x| (x, y)))
+        .filter(|&(x, y)| image.get_pixel(x, y).0 == [255, 0, 255])
+        .count();
+    assert_eq!(
+        clear, 0,
+        "{clear} pixels of the lower half show the clear colour"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
     let dir = temp_dir("generate-drainage");

@@ -43,13 +43,14 @@ fn render_air(ctx: &Context, camera: &Camera, size: [u32; 2], on: bool) -> image
 
 fn preset_camera(preset: Preset, aspect: f64) -> Camera {
     let (eye, target) = presets::camera(preset, world()).unwrap();
-    let altitude = eye.length() - world().planet.radius;
+    let ground = riverplanet::render::ground::Ground::new(world()).height_below(eye, world());
+    let altitude = eye.length() - world().planet.radius - ground;
     Camera::look_at(
         eye,
         target,
         45.0,
         aspect,
-        (altitude * 0.05).clamp(0.01, 10.0),
+        riverplanet::runtime::camera::near_plane(altitude),
     )
 }
 
@@ -304,7 +305,7 @@ fn no_pixel_inside_the_planet_shows_the_clear_colour() {
             *target,
             60.0,
             4.0 / 3.0,
-            (altitude * 0.05).clamp(0.01, 10.0),
+            riverplanet::runtime::camera::near_plane(altitude),
         );
         let image = render(ctx, &camera, size, WaterMode::Auto);
         let inner = r + world.planet.stats.min_height as f64 - 2.0;

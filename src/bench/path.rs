@@ -108,7 +108,7 @@ impl Flight {
             target,
             60.0,
             self.aspect,
-            (altitude * 0.05).clamp(0.01, 10.0),
+            crate::runtime::camera::near_plane(altitude),
         )
     }
 
@@ -127,7 +127,7 @@ impl Flight {
             look,
             60.0,
             self.aspect,
-            (altitude * 0.05).clamp(0.01, 10.0),
+            crate::runtime::camera::near_plane(altitude),
         )
     }
 }

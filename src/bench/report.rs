@@ -432,11 +432,27 @@ fn map_ms(v: &Value) -> String {
     }
 }
 
-/// `ratio` (a time over a reference time) in words: "1.3x slower than" or "1.1x faster than".
+/// `ratio` (a time over a reference time) in words: "1.3x slower than", "1.1x faster than", or within 5 % "about
+/// as fast as" (which one decimal would print as a meaningless "1.0x faster").
 fn slower_or_faster(ratio: f64) -> String {
-    if ratio >= 1.0 {
+    if (0.95..=1.05).contains(&ratio) {
+        "about as fast as".to_string()
+    } else if ratio >= 1.0 {
         format!("{ratio:.1}x slower than")
     } else {
         format!("{:.1}x faster than", 1.0 / ratio)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::slower_or_faster;
+
+    #[test]
+    fn ratios_read_as_words() {
+        assert_eq!(slower_or_faster(1.3), "1.3x slower than");
+        assert_eq!(slower_or_faster(1.0 / 1.1), "1.1x faster than");
+        // 207.150 against 209.293 ms, the latest run's simple kernel against the CPU reference.
+        assert_eq!(slower_or_faster(207.150 / 209.293), "about as fast as");
     }
 }

@@ -85,13 +85,16 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         renderer.morphing,
         config.rendering.level_of_detail_rule,
     );
-    let altitude = eye.length() - config.planet.radius as f64;
+    // Above the drawn surface (terrain or water) below the eye, not the radius: high ground would clip the surface
+    // in front of a camera close above it.
+    let ground = riverplanet::render::ground::Ground::new(&world).height_below(eye, &world);
+    let altitude = eye.length() - config.planet.radius as f64 - ground;
     let mut camera = riverplanet::runtime::camera::Camera::look_at(
         eye,
         look_at,
         args.fov,
         w as f64 / h as f64,
-        (altitude * 0.05).clamp(0.01, 10.0),
+        riverplanet::runtime::camera::near_plane(altitude),
     );
     if let Some(up) = args.up {
         camera.up = up.normalize();

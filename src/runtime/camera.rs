@@ -17,6 +17,13 @@ pub struct Camera {
     pub near: f64,
 }
 
+/// The near plane for a camera `altitude` above the drawn surface below it: a twentieth of it, between 1 cm and 10
+/// units, so that the surface in front of the camera is never clipped (with reversed Z the depth stays precise
+/// whatever the near plane).
+pub fn near_plane(altitude: f64) -> f64 {
+    (altitude * 0.05).clamp(0.01, 10.0)
+}
+
 impl Camera {
     /// A camera at `eye` looking at `target`, with up towards the planet's outward normal at the eye.
     pub fn look_at(eye: DVec3, target: DVec3, fov_y_degrees: f64, aspect: f64, near: f64) -> Self {

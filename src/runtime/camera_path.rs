@@ -44,7 +44,7 @@ impl PathFrame {
     /// The camera of this frame for a viewport of `aspect`.
     pub fn camera(&self, aspect: f64) -> Camera {
         let position = DVec3::from_array(self.position);
-        let near = (self.altitude * 0.05).clamp(0.01, 10.0);
+        let near = super::camera::near_plane(self.altitude);
         let mut camera = Camera::look_at(
             position,
             position + DVec3::from_array(self.forward),

@@ -242,7 +242,7 @@ impl App<'_> {
         let altitude = self.altitude().max(0.01);
         self.camera.camera(
             width as f64 / height.max(1) as f64,
-            (altitude * 0.05).clamp(0.01, 10.0),
+            crate::runtime::camera::near_plane(altitude),
         )
     }
 
