@@ -27,7 +27,7 @@ void main() {
     // painting it is far from every river (as a patch without rivers, terrain_vertex.glsl), so that a triangle
     // reaching it paints no river between its vertices (terrain.frag, distanceSlope).
     if (v.surface.w == 0.0) s.river.z = FAR_FROM_RIVERS;
-    s.inBasin = abs(v.surface.z) < v.surface.w;
+    s.inBasin = inRiverBasin(v.surface);
     s.direction = v.direction;
     // The patch centre's world position (mod the period, from f64) plus the vertex's small offset from it.
     s.detail = p.detail.xyz + v.local;

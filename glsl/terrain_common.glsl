@@ -47,6 +47,10 @@ struct PatchInstance {
     vec4 detail;      // xyz: the patch centre's world position modulo DETAIL_PERIOD (computed in f64)
 };
 
+// Whether a vertex of `surface` (terrain height, water height, signed distance, half width) lies in a river's
+// basin: |signed distance| < half width (Section 8.4; false where no river reaches, half width 0).
+bool inRiverBasin(vec4 surface) { return abs(surface.z) < surface.w; }
+
 // smoothstep with the division by the band's width written as a product, so that constant edges fold to one
 // constant factor (lavapipe runs a division per lane, several times slower than a product); the same curve.
 float smoothBand(float e0, float e1, float x) {

@@ -151,7 +151,7 @@ float placedHeight(vec4 surface) {
     float height = surface.x;
     if (!waterInMesh()) return height;
     height = max(height, frame.sun.w);
-    if (waterMode() != WATER_PAINTED && abs(surface.z) < surface.w) height = max(height, surface.y);
+    if (waterMode() != WATER_PAINTED && inRiverBasin(surface)) height = max(height, surface.y);
     return height;
 }
 

@@ -14,7 +14,7 @@ const uint WATER_SEA = 3u;        // the sea
 // where any vertex lies below sea level.
 uint waterKind(vec4 r0, vec4 r1, vec4 r2, float spacing) {
     float seaLevel = frame.sun.w;
-    bool inBasin = abs(r0.z) < r0.w || abs(r1.z) < r1.w || abs(r2.z) < r2.w;
+    bool inBasin = inRiverBasin(r0) || inRiverBasin(r1) || inRiverBasin(r2);
     bool belowSea = r0.x < seaLevel || r1.x < seaLevel || r2.x < seaLevel;
     float widest = max(r0.w, max(r1.w, r2.w));
     uint mode = waterMode();

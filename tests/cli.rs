@@ -6,6 +6,17 @@ fn riverplanet() -> Command {
     Command::new(env!("CARGO_BIN_EXE_riverplanet"))
 }
 
+/// Runs `command` and asserts that it succeeded, with its error output as the message.
+fn succeeded(command: &mut Command) -> std::process::Output {
+    let run = command.output().unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    run
+}
+
 /// Asserts that `run` failed with exit code `code`, without a panic, and that its message names every culprit.
 fn assert_refused(run: &std::process::Output, code: i32, culprits: &[&str]) {
     let stderr = String::from_utf8_lossy(&run.stderr);
@@ -223,26 +234,21 @@ fn render_draws_the_water_in_front_of_a_camera_close_above_high_ground() {
     let dir = temp_dir("near");
     let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml");
     let out = dir.join("ground.png");
-    let run = riverplanet()
-        .args([
-            "render",
-            "--preset",
-            "ground",
-            "--size",
-            "160x90",
-            "--atmosphere",
-            "off",
-        ])
-        .args(["--clear-color", "1,0,1", "--config"])
-        .arg(&config)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    succeeded(
+        riverplanet()
+            .args([
+                "render",
+                "--preset",
+                "ground",
+                "--size",
+                "160x90",
+                "--atmosphere",
+                "off",
+            ])
+            .args(["--clear-color", "1,0,1", "--config"])
+            .arg(&config)
+            .arg("--out")
+            .arg(&out),
     );
     let image = image::open(&out).unwrap().to_rgb8();
     let clear = (45..90)
@@ -260,25 +266,20 @@ fn render_draws_the_water_in_front_of_a_camera_close_above_high_ground() {
 fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
     let dir = temp_dir("generate-drainage");
     let config = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml");
-    let run = riverplanet()
-        .args([
-            "generate",
-            "--seed",
-            "2",
-            "--level",
-            "3",
-            "--preview",
-            "--config",
-        ])
-        .arg(&config)
-        .arg("--out")
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    succeeded(
+        riverplanet()
+            .args([
+                "generate",
+                "--seed",
+                "2",
+                "--level",
+                "3",
+                "--preview",
+                "--config",
+            ])
+            .arg(&config)
+            .arg("--out")
+            .arg(&dir),
     );
     let stats: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("stats.json")).unwrap()).unwrap();
@@ -471,15 +472,10 @@ fn bad_output_paths_are_refused_before_any_work_and_nothing_is_overwritten() {
         assert!(started.elapsed().as_secs_f64() < 5.0);
     }
     assert_eq!(std::fs::read(&keep).unwrap(), b"keep");
-    let run = riverplanet()
-        .args(["render", "--size", "32x18", "--out"])
-        .arg(dir.join("ok.png"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    succeeded(
+        riverplanet()
+            .args(["render", "--size", "32x18", "--out"])
+            .arg(dir.join("ok.png")),
     );
     // Written through a temporary file that was renamed: nothing else is left in the folder.
     let mut names: Vec<String> = std::fs::read_dir(&dir)
@@ -493,24 +489,19 @@ fn bad_output_paths_are_refused_before_any_work_and_nothing_is_overwritten() {
 #[test]
 fn cameras_take_negative_coordinates_and_a_preset_refuses_an_eye() {
     let dir = temp_dir("camera");
-    let run = riverplanet()
-        .args([
-            "render",
-            "--eye",
-            "-610,430,890",
-            "--look-at",
-            "-1,0,0",
-            "--size",
-            "32x18",
-            "--out",
-        ])
-        .arg(dir.join("negative.png"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    succeeded(
+        riverplanet()
+            .args([
+                "render",
+                "--eye",
+                "-610,430,890",
+                "--look-at",
+                "-1,0,0",
+                "--size",
+                "32x18",
+                "--out",
+            ])
+            .arg(dir.join("negative.png")),
     );
     let run = riverplanet()
         .args(["render", "--preset", "orbit", "--eye", "1,2,3000", "--out"])
@@ -675,15 +666,10 @@ fn a_new_planet_prints_its_seed_and_that_seed_makes_it_again() {
 #[test]
 fn outside_the_repository_the_built_in_default_configuration_is_used() {
     let dir = temp_dir("anywhere");
-    let run = riverplanet()
-        .current_dir(&dir)
-        .args(["generate", "--level", "0", "--out", "out"])
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    let run = succeeded(
+        riverplanet()
+            .current_dir(&dir)
+            .args(["generate", "--level", "0", "--out", "out"]),
     );
     // The built-in default is Appendix A's planet with the drainage model and seed 1.
     assert_eq!(printed_seed(&run.stdout), 1);
@@ -848,24 +834,19 @@ fn a_recorded_camera_path_replays_in_render_and_bench_flight() {
     assert!(!dir.join("no.png").exists());
 
     let json = dir.join("flight.json");
-    let run = riverplanet()
-        .args([
-            "bench",
-            "flight",
-            "--path",
-            path_arg,
-            "--size",
-            "96x54",
-            "--summary-only",
-        ])
-        .args(["--no-kernel-comparison", "--no-water-comparison", "--json"])
-        .arg(&json)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    succeeded(
+        riverplanet()
+            .args([
+                "bench",
+                "flight",
+                "--path",
+                path_arg,
+                "--size",
+                "96x54",
+                "--summary-only",
+            ])
+            .args(["--no-kernel-comparison", "--no-water-comparison", "--json"])
+            .arg(&json),
     );
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();

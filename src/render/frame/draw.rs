@@ -259,16 +259,19 @@ impl Renderer<'_> {
                 }
             }
         }
-        // Cached patches draw their water through the cache pass's indirect draws (instance k is patch k); the
-        // rest as instances of their own.
+        // The thesis's water pass, unless the terrain mesh carries the water: cached patches draw their water
+        // through the cache pass's indirect draws (instance k is patch k), the rest as instances of their own.
+        let water_pass = !self.wireframe_on && !self.draws_water_in_mesh(camera);
         let first = instances.len() as u32;
-        instances.extend(
-            drawn
-                .iter()
-                .skip(cached)
-                .filter(|d| d.wet)
-                .map(|d| d.instance),
-        );
+        if water_pass {
+            instances.extend(
+                drawn
+                    .iter()
+                    .skip(cached)
+                    .filter(|d| d.wet)
+                    .map(|d| d.instance),
+            );
+        }
         let water_instances = first..instances.len() as u32;
         let instance_buffer = {
             let mut buffer = ctx.create_buffer(&BufferDesc {
@@ -306,8 +309,14 @@ impl Renderer<'_> {
             None
         };
         let vertex_cache = VertexCache::buffer(ctx, cached, n)?;
-        let water_draws = VertexCache::water_draws(ctx, cached, &self.quadrants)?;
-        let water_indices = VertexCache::water_indices(ctx, cached, n)?;
+        let (water_draws, water_indices) = if water_pass {
+            (
+                Some(VertexCache::water_draws(ctx, cached, &self.quadrants)?),
+                Some(VertexCache::water_indices(ctx, cached, n)?),
+            )
+        } else {
+            (None, None)
+        };
         let draw_sky = self.sky().is_some();
         let dome_vertices = draw_sky.then(|| Sky::dome_vertices(ctx)).transpose()?;
         let instance_set = rec.buffer_set(
@@ -316,9 +325,9 @@ impl Renderer<'_> {
                 &instance_buffer,
                 capture.as_ref().unwrap_or(&self.placeholder),
                 &vertex_cache,
-                &water_draws,
+                water_draws.as_ref().unwrap_or(&self.placeholder),
                 &self.indices,
-                &water_indices,
+                water_indices.as_ref().unwrap_or(&self.placeholder),
                 dome_vertices.as_ref().unwrap_or(&self.placeholder),
             ],
         )?;
@@ -329,7 +338,6 @@ impl Renderer<'_> {
         let sets = [self.bindless.set, instance_set];
         let push = bytemuck::bytes_of(&push);
         let scope = self.frames.profiler().begin(rec, "vertices")?;
-        let water_pass = !self.wireframe_on && !self.draws_water_in_mesh(camera);
         self.vertex_cache
             .record(rec, (&sets, push), &vertex_cache, cached, n, water_pass);
         self.frames.profiler().end(rec, scope);
@@ -375,12 +383,12 @@ impl Renderer<'_> {
         }
         self.frames.profiler().end(rec, scope);
         let scope = self.frames.profiler().begin(rec, "water")?;
-        if water_pass {
+        if let (Some(indices), Some(draws)) = (&water_indices, &water_draws) {
             rec.draw_indexed_indirect(
                 &self.cached_water,
                 (&sets, push),
-                &water_indices,
-                &water_draws,
+                indices,
+                draws,
                 4 * cached as u32,
             );
             for mesh in &self.quadrants {
@@ -394,8 +402,9 @@ impl Renderer<'_> {
                 );
             }
         }
-        rec.free_after_completion(water_draws);
-        rec.free_after_completion(water_indices);
+        for buffer in water_draws.into_iter().chain(water_indices) {
+            rec.free_after_completion(buffer);
+        }
         if let Some(vertices) = dome_vertices {
             rec.free_after_completion(vertices);
         }

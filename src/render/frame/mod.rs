@@ -104,8 +104,8 @@ pub struct Renderer<'w> {
     /// The atmosphere's table and sky pass; `None` for a planet without air (`atmosphere-height` 0).
     sky: Option<sky::Sky>,
     instance_layout: BufferSetLayout,
-    /// Bound in place of the vertex capture when vertices are not captured, and of the sky dome's vertices when
-    /// no sky is drawn.
+    /// Bound in place of the vertex capture when vertices are not captured, of the water pass's draws and
+    /// indices when the terrain mesh carries the water, and of the sky dome's vertices when no sky is drawn.
     placeholder: Buffer,
     vertex_cache: vertex_cache::VertexCache,
     indices: Buffer,
