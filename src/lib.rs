@@ -14,6 +14,7 @@ pub mod bench;
 pub mod config;
 pub mod drainage;
 pub mod export;
+pub mod geomorphology;
 pub mod gpu;
 pub mod kernel;
 pub mod named;

@@ -1,6 +1,6 @@
 //! The XML configuration: Appendix A as printed, and every class of bad input reported by element and range.
 
-use riverplanet::config::{Config, ConfigError, LodRule, RiverModel};
+use riverplanet::config::{Config, ConfigError, LodRule, ReliefModel, RiverModel};
 
 const APPENDIX_A: &str = include_str!("../config/thesis.xml");
 
@@ -60,7 +60,7 @@ fn the_shipped_files_load_from_disk_with_their_models() {
             LodRule::ScreenSpaceError,
         ),
         ("thesis.xml", RiverModel::Thesis, LodRule::Distance),
-        ("earth.xml", RiverModel::Thesis, LodRule::Distance),
+        ("earth.xml", RiverModel::Drainage, LodRule::Distance),
     ] {
         let c = Config::load(&dir.join(file)).unwrap();
         assert_eq!(c.river.model, model, "{file}");
@@ -99,7 +99,8 @@ fn the_level_of_detail_rule_and_pixel_error_are_named_or_refused() {
 fn without_a_river_model_the_drainage_model_and_its_defaults_apply() {
     let c = Config::parse("<planet></planet>", "t.xml").unwrap();
     assert_eq!(c.river.model, RiverModel::Drainage);
-    assert_eq!(c.river.source_area, 700.0);
+    assert_eq!(c.planet.relief_model, ReliefModel::Eroded);
+    assert_eq!(c.river.source_area, 300.0);
     assert_eq!(Config::default().river.model, RiverModel::Drainage);
     assert_eq!(Config::appendix_a().river.model, RiverModel::Thesis);
     assert_eq!(Config::appendix_a().planet.detail_amplitude, 8.0);
@@ -243,10 +244,47 @@ fn the_river_model_is_named_or_refused() {
 }
 
 #[test]
+fn the_relief_model_is_named_and_fits_its_river_model_or_is_refused() {
+    let message = error_of(&with("planet-attributes", "relief-model", "rain"));
+    assert!(
+        message.contains("relief-model") && message.contains("thesis, carved, eroded"),
+        "{message}"
+    );
+    // The thesis's rivers start at the thesis's mountains; the drainage model drains the other reliefs.
+    let drainage = with("river-attributes", "river-model", "drainage");
+    let message = error_of(&drainage.replacen(
+        "<planet-attributes>",
+        "<planet-attributes><relief-model>thesis</relief-model>",
+        1,
+    ));
+    assert!(message.contains("eroded or carved"), "{message}");
+    let message = error_of(&with("planet-attributes", "relief-model", "eroded"));
+    assert!(message.contains("must be thesis"), "{message}");
+    assert_eq!(
+        Config::parse(APPENDIX_A, "t.xml")
+            .unwrap()
+            .planet
+            .relief_model,
+        ReliefModel::Thesis
+    );
+}
+
+#[test]
 fn the_drainage_model_brings_its_own_defaults_and_explicit_values_still_win() {
     let drainage = with("river-attributes", "river-model", "drainage");
     let c = Config::parse(&drainage, "t.xml").unwrap();
-    assert_eq!(c.river.source_area, 700.0);
+    assert_eq!(c.river.source_area, 300.0);
+    // The carved relief keeps the source area it was tuned with.
+    let carved = drainage.replacen(
+        "<planet-attributes>",
+        "<planet-attributes><relief-model>carved</relief-model>",
+        1,
+    );
+    let c = Config::parse(&carved, "t.xml").unwrap();
+    assert_eq!(
+        (c.planet.relief_model, c.river.source_area),
+        (ReliefModel::Carved, 700.0)
+    );
     assert_eq!(c.planet.detail_amplitude, 2.0);
     assert_eq!(c.river.samples_per_vertex_spacing, 4);
     let explicit = drainage.replacen(

@@ -177,6 +177,12 @@ fn assert_natural(config: &riverplanet::config::Config, seed: u32) {
             assert!(d.reaches[next].beds[0] <= *reach.beds.last().unwrap());
         }
     }
+    // The courses as drawn (meandering where the relief is eroded) cross nowhere.
+    let crossing = riverplanet::drainage::meanders::crossing_reaches(&d.reaches);
+    assert!(
+        crossing.is_empty(),
+        "seed {seed}: reaches {crossing:?} cross"
+    );
 }
 
 #[test]

@@ -69,6 +69,43 @@ pub struct PlanetConfig {
     pub detail_amplitude: f32,
     /// Cells per face edge of the coarsest heightmap on which continents are built: 2^n+1.
     pub base_resolution: u32,
+    /// How the relief is made (the thesis's square mountains, or the drainage model's carved or eroded relief).
+    pub relief_model: ReliefModel,
+}
+
+/// How the land gets its relief.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ReliefModel {
+    /// Chapter 4: a plateau at `continent-height` with 3x3 mountain masks (the thesis's river model needs it).
+    Thesis,
+    /// Beyond the thesis: ridged noise rising from the coasts, with valleys carved around the rivers afterwards
+    /// (docs/planet.md, "Relief of the drainage model").
+    Carved,
+    /// Beyond the thesis, the default: tectonic uplift balanced by stream-power erosion (docs/planet.md, "Relief
+    /// from uplift and erosion"); the rivers are the ones the erosion made.
+    Eroded,
+}
+
+impl ReliefModel {
+    /// The default `source-area` of the drainage model on this relief (world units squared): eroded relief drains
+    /// in more branched networks, whose first-order streams start at 300 square units (about two base cells;
+    /// docs/geomorphology.md measures Horton's ratio and Strahler's order with it); the carved relief keeps the
+    /// 700 it was tuned with. Irrelevant to the thesis's model.
+    pub fn source_area(self) -> f32 {
+        match self {
+            ReliefModel::Eroded => 300.0,
+            ReliefModel::Carved | ReliefModel::Thesis => 700.0,
+        }
+    }
+}
+
+impl crate::named::Named for ReliefModel {
+    const ALL: &'static [(&'static str, Self)] = &[
+        ("thesis", Self::Thesis),
+        ("carved", Self::Carved),
+        ("eroded", Self::Eroded),
+    ];
 }
 
 /// Where rivers come from.
@@ -187,8 +224,9 @@ impl Config {
         let mut d = Self::appendix_a();
         d.river.model = model;
         if model == RiverModel::Drainage {
+            d.planet.relief_model = ReliefModel::Eroded;
             d.planet.detail_amplitude = 2.0;
-            d.river.source_area = 700.0;
+            d.river.source_area = d.planet.relief_model.source_area();
             d.river.samples_per_vertex_spacing = 4;
             d.rendering.level_of_detail_rule = LodRule::ScreenSpaceError;
         }
@@ -216,6 +254,7 @@ impl Config {
                 coast_perturbation: 3.0,
                 detail_amplitude: 8.0,
                 base_resolution: 129,
+                relief_model: ReliefModel::Thesis,
             },
             river: RiverConfig {
                 model: RiverModel::Thesis,

@@ -8,8 +8,8 @@ use std::fmt;
 use xml::reader::{EventReader, XmlEvent};
 
 use super::{
-    Config, ConfigError, PlanetConfig, RenderingConfig, RiverConfig, MAX_LATTICE_CELLS,
-    MAX_LEVEL_OF_DETAIL,
+    Config, ConfigError, PlanetConfig, ReliefModel, RenderingConfig, RiverConfig, RiverModel,
+    MAX_LATTICE_CELLS, MAX_LEVEL_OF_DETAIL,
 };
 use crate::named::Named;
 
@@ -121,6 +121,7 @@ const PLANET: &[Param<PlanetConfig>] = &[
         &mut c.detail_amplitude
     }),
     Param::Grid("base-resolution", 9, 1025, |c| &mut c.base_resolution),
+    Param::Choice("relief-model", |c, text| choose(text, &mut c.relief_model)),
 ];
 
 /// `<river-attributes>`.
@@ -440,6 +441,10 @@ impl Config {
             &mut config.planet,
             (path, folder),
         )?;
+        // The relief, read with the planet, brings the drainage model's default source area.
+        if config.river.model == RiverModel::Drainage {
+            config.river.source_area = config.planet.relief_model.source_area();
+        }
         read_section(
             (SECTIONS[1], &river),
             RIVER,
@@ -475,6 +480,19 @@ impl Config {
                     "must lie between ocean-height ({}) and continent-height ({})",
                     planet.ocean_height, planet.continent_height
                 ),
+            ));
+        }
+        // The thesis's rivers start at its square mountains; the drainage model drains any other relief.
+        if (planet.relief_model == ReliefModel::Thesis) != (river.model == RiverModel::Thesis) {
+            return Err(error(
+                "relief-model",
+                planet.relief_model.name().to_string(),
+                match river.model {
+                    RiverModel::Thesis => "must be thesis with river-model thesis".to_string(),
+                    RiverModel::Drainage => {
+                        "must be eroded or carved with river-model drainage".to_string()
+                    }
+                },
             ));
         }
         let widest = river.starting_width * river.ending_factor.max(1.0);

@@ -4,6 +4,7 @@
 //! `<river-model>thesis</river-model>`.
 
 pub mod grid;
+pub mod meanders;
 pub mod rivers;
 pub mod routing;
 pub mod valleys;
@@ -12,7 +13,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::{
-    config::{PlanetConfig, RiverConfig},
+    config::{PlanetConfig, ReliefModel, RiverConfig},
     planet::heights::FaceLattice,
 };
 use grid::SphereGrid;
@@ -73,7 +74,11 @@ pub fn drain(
             lake_depth: river.lake_depth as f64,
         },
     );
-    let carved = valleys::carve(grid, &routing, &network, &heights, sea_level);
+    // Eroded relief has its valleys already: the rivers are the ones the erosion cut.
+    let carved = match planet.relief_model {
+        ReliefModel::Eroded => valleys::cut_beds(grid, &routing, &network, &heights, sea_level),
+        _ => valleys::carve(grid, &routing, &network, &heights, sea_level),
+    };
     grid.write(&carved, lattice);
     let r2 = radius * radius;
     let directions = |nodes: &[u32]| -> Vec<DVec3> {
@@ -98,6 +103,19 @@ pub fn drain(
         .iter()
         .flat_map(|r| r.areas.iter().copied())
         .fold(0.0, f64::max);
+    // Rivers on the eroded relief meander through their valleys (the carved relief keeps the thesis-era paths).
+    let reaches = match planet.relief_model {
+        ReliefModel::Eroded => {
+            let scale = meanders::MeanderScale {
+                cell: std::f64::consts::FRAC_PI_2 / grid.cells as f64,
+                radius,
+                relief_slope: (planet.max_mountain_height - planet.sea_level_height) as f64
+                    / radius,
+            };
+            meanders::meander_all(&reaches, &scale, |a| width(river, largest_area, a) as f64)
+        }
+        _ => reaches,
+    };
     let lakes = network
         .lakes
         .iter()
@@ -118,6 +136,15 @@ pub fn drain(
         measures: network.measures,
         largest_area,
     }
+}
+
+/// Hydraulic geometry: a river's full width grows with the square root of its discharge, taken as proportional
+/// to its drainage area (world units squared), from `min-width` at no area to the widest river (`starting-width
+/// x ending-factor`) at the planet's largest drainage area.
+pub fn width(river: &RiverConfig, largest_area: f64, area: f64) -> f32 {
+    let widest = river.starting_width * river.ending_factor.max(1.0);
+    let share = (area / largest_area.max(f64::MIN_POSITIVE)).sqrt() as f32;
+    river.min_width + (widest - river.min_width) * share.clamp(0.0, 1.0)
 }
 
 /// Bed heights along a reach: the carved terrain at its river nodes; at a mouth the sea level or the lake's level;

@@ -41,8 +41,8 @@ pub struct DrainageMeasures {
     pub strahler_max: u32,
     /// Strahler streams of each order (index 0: order 1) in the basins of order [`HORTON_BASIN_ORDER`] and more.
     pub streams_per_order: Vec<usize>,
-    /// Horton's bifurcation ratio: exp(-slope) of the least-squares line through ln(streams of order w) over w,
-    /// in the basins of order [`HORTON_BASIN_ORDER`] and more.
+    /// Horton's bifurcation ratio: exp(-slope) of the least-squares lines through ln(streams of order w) over w
+    /// within each basin of order [`HORTON_BASIN_ORDER`] and more, one slope shared by all of them.
     pub bifurcation_ratio: f64,
     /// Hack's exponent: least-squares slope of ln(main-stream length) over ln(drainage area) at the lower end of
     /// every reach.
@@ -230,6 +230,28 @@ fn slope(points: &[(f64, f64)]) -> f64 {
     }
 }
 
+/// The least-squares slope of y over x shared by several groups of points, each with its own intercept (the
+/// slope fitted within groups): Horton's law holds within a basin, N_w = R^(order - w), so basins of different
+/// orders are not pooled into one line (pooling counts every basin's top stream as if all had the same order).
+fn within_basin_slope(groups: &[Vec<(f64, f64)>]) -> f64 {
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for g in groups.iter().filter(|g| g.len() >= 2) {
+        let n = g.len() as f64;
+        let (mx, my) = g
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+        for (x, y) in g {
+            sxy += (x - mx) * (y - my);
+            sxx += (x - mx) * (x - mx);
+        }
+    }
+    if sxx == 0.0 {
+        f64::NAN
+    } else {
+        sxy / sxx
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn measure(
     grid: &SphereGrid,
@@ -253,18 +275,35 @@ fn measure(
         reaches[r].strahler
     };
     let basin_order = HORTON_BASIN_ORDER.min(strahler_max);
+    let outlet = |mut r: usize| {
+        while let Some(d) = reaches[r].downstream {
+            r = d;
+        }
+        r
+    };
     let mut streams = vec![0usize; strahler_max as usize + 1];
+    // Streams per order in each basin (by its outlet reach).
+    let mut per_basin: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
     for (r, reach) in reaches.iter().enumerate() {
         let starts = !incoming[r]
             .iter()
             .any(|&u| reaches[u as usize].strahler == reach.strahler);
         if starts && outlet_order(r) >= basin_order {
             streams[reach.strahler as usize] += 1;
+            let basin = per_basin
+                .entry(outlet(r))
+                .or_insert_with(|| vec![0; strahler_max as usize + 1]);
+            basin[reach.strahler as usize] += 1;
         }
     }
-    let horton: Vec<(f64, f64)> = (1..=strahler_max)
-        .filter(|&w| streams[w as usize] > 0)
-        .map(|w| (w as f64, (streams[w as usize] as f64).ln()))
+    let horton: Vec<Vec<(f64, f64)>> = per_basin
+        .values()
+        .map(|counts| {
+            (1..=strahler_max)
+                .filter(|&w| counts[w as usize] > 0)
+                .map(|w| (w as f64, (counts[w as usize] as f64).ln()))
+                .collect()
+        })
         .collect();
     // Hack: the longest flow path above each node (to the divide), upstream first.
     let mut longest = vec![0.0f64; n];
@@ -319,7 +358,7 @@ fn measure(
         lakes: 0,
         strahler_max,
         streams_per_order: streams[1..].to_vec(),
-        bifurcation_ratio: (-slope(&horton)).exp(),
+        bifurcation_ratio: (-within_basin_slope(&horton)).exp(),
         hack_exponent: slope(&hack),
         drained_land_fraction: if land > 0.0 { drained_land / land } else { 0.0 },
         uphill_steps,

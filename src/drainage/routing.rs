@@ -26,8 +26,9 @@ pub struct Routing {
     pub crossing: usize,
 }
 
-/// Routes `heights` (one per grid node) to the sea: nodes at or below `sea_level` are outlets.
-pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
+/// Fills the depressions of `heights` and sends every land node to its steepest lower neighbour on the filled
+/// surface; `area` is left empty ([`accumulate`]). Diagonal flows may cross (landscape evolution does not mind).
+pub fn steepest_descent(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
     let n = grid.len();
     let span = heights
         .iter()
@@ -37,14 +38,22 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
     let mut filled = heights.to_vec();
     let mut closed = vec![false; n];
     let mut open = BinaryHeap::new();
+    // Sea nodes drain nowhere; only those beside land need to enter the queue.
+    let mut downstream_first = Vec::with_capacity(n);
     for k in 0..n {
         if heights[k] <= sea_level {
             closed[k] = true;
-            open.push(Reverse((Ordered(heights[k]), k as u32)));
+            let coast = grid
+                .neighbours(k as u32)
+                .iter()
+                .any(|&j| heights[j as usize] > sea_level);
+            match coast {
+                true => open.push(Reverse((Ordered(heights[k]), k as u32))),
+                false => downstream_first.push(k as u32),
+            }
         }
     }
     // Nodes leave the queue in order of their filled height, so every node comes after the nodes below it.
-    let mut downstream_first = Vec::with_capacity(n);
     while let Some(Reverse((Ordered(h), node))) = open.pop() {
         downstream_first.push(node);
         for &next in grid.neighbours(node) {
@@ -62,15 +71,27 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
             false => steepest_lower(grid, &filled, k, &[]),
         })
         .collect();
-    let mut routing = Routing {
+    Routing {
         filled,
         receiver,
         upstream_first: downstream_first.into_iter().rev().collect(),
         area: Vec::new(),
         turned: 0,
         crossing: 0,
-    };
+    }
+}
+
+/// Routes `heights` (one per grid node) to the sea: nodes at or below `sea_level` are outlets. No two flows cross
+/// a lattice quad's diagonals ([`uncross_diagonals`]).
+pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
+    let mut routing = steepest_descent(grid, heights, sea_level);
     uncross_diagonals(grid, &mut routing);
+    accumulate(grid, &mut routing);
+    routing
+}
+
+/// Drainage area of every node: its own area plus everything that drains through it.
+pub fn accumulate(grid: &SphereGrid, routing: &mut Routing) {
     let mut area = grid.areas.clone();
     for &k in &routing.upstream_first {
         let r = routing.receiver[k as usize];
@@ -79,7 +100,6 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
         }
     }
     routing.area = area;
-    routing
 }
 
 /// The neighbour of `node` with the steepest descent on `filled` (drop over angle), leaving out `except`;

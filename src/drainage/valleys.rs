@@ -9,33 +9,23 @@ const NARROWEST: f64 = 1.5;
 /// Half-width of the largest river's valley, in base lattice cells.
 const WIDEST: f64 = 4.0;
 
-/// The heights with valleys carved. A river node sits at its bed: its filled height, lowered to the lowest of its
-/// neighbours (D8 lets a river run along a side slope, whose lower side would otherwise stand below the water),
-/// and never rising downstream. A node within a valley's half-width `w` at distance `d` of its nearest river node
-/// keeps its height above that bed scaled by `(d / w)^2`, never raised. Sea and lake nodes keep their heights.
-pub fn carve(
+/// The river nodes (on dry land) and the bed of each: its filled height, lowered to the lowest of its neighbours
+/// (D8 lets a river run along a side slope, whose lower side would otherwise stand below the water), and never
+/// rising downstream.
+fn river_beds(
     grid: &SphereGrid,
     routing: &Routing,
     network: &DrainageNetwork,
     heights: &[f64],
     sea_level: f64,
-) -> Vec<f64> {
+) -> (Vec<u32>, Vec<f64>) {
     let dry = |k: usize| heights[k] > sea_level && network.lake_of[k].is_none();
-    let cell = std::f64::consts::FRAC_PI_2 / grid.cells as f64;
     let river_nodes: Vec<u32> = network
         .reaches
         .iter()
         .flat_map(|r| r.nodes.iter().copied())
         .filter(|&k| dry(k as usize))
         .collect();
-    let largest = river_nodes
-        .iter()
-        .map(|&k| routing.area[k as usize])
-        .fold(0.0, f64::max);
-    let half_width = |k: u32| {
-        let share = (routing.area[k as usize] / largest).sqrt();
-        cell * (NARROWEST + (WIDEST - NARROWEST) * share)
-    };
     let mut bed: Vec<f64> = routing.filled.clone();
     for &k in &river_nodes {
         // A neighbour under the sea or a lake counts at the water's surface: a river beside the coast comes
@@ -61,6 +51,47 @@ pub fn carve(
             bed[r as usize] = bed[r as usize].min(bed[k as usize]);
         }
     }
+    (river_nodes, bed)
+}
+
+/// The heights with every river node at its bed ([`river_beds`]) and nothing else changed: the eroded relief's
+/// valleys are the erosion's own, only the sills that filled depressions leave along a river are cut.
+pub fn cut_beds(
+    grid: &SphereGrid,
+    routing: &Routing,
+    network: &DrainageNetwork,
+    heights: &[f64],
+    sea_level: f64,
+) -> Vec<f64> {
+    let (river_nodes, bed) = river_beds(grid, routing, network, heights, sea_level);
+    let mut out = heights.to_vec();
+    for k in river_nodes {
+        out[k as usize] = bed[k as usize];
+    }
+    out
+}
+
+/// The heights with valleys carved. A river node sits at its bed ([`river_beds`]). A node within a valley's
+/// half-width `w` at distance `d` of its nearest river node keeps its height above that bed scaled by
+/// `(d / w)^2`, never raised. Sea and lake nodes keep their heights.
+pub fn carve(
+    grid: &SphereGrid,
+    routing: &Routing,
+    network: &DrainageNetwork,
+    heights: &[f64],
+    sea_level: f64,
+) -> Vec<f64> {
+    let dry = |k: usize| heights[k] > sea_level && network.lake_of[k].is_none();
+    let cell = std::f64::consts::FRAC_PI_2 / grid.cells as f64;
+    let (river_nodes, bed) = river_beds(grid, routing, network, heights, sea_level);
+    let largest = river_nodes
+        .iter()
+        .map(|&k| routing.area[k as usize])
+        .fold(0.0, f64::max);
+    let half_width = |k: u32| {
+        let share = (routing.area[k as usize] / largest).sqrt();
+        cell * (NARROWEST + (WIDEST - NARROWEST) * share)
+    };
     let (distance, nearest) = grid.nearest(&river_nodes, WIDEST * cell);
     let mut out = heights.to_vec();
     for k in 0..grid.len() {

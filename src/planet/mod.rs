@@ -4,10 +4,13 @@
 
 pub mod air;
 pub mod atmosphere;
+pub mod coasts;
 pub mod continents;
 pub mod cube;
 pub mod detail;
+pub mod erosion;
 pub mod heights;
+pub mod lakes;
 pub mod mountains;
 pub mod noise;
 pub mod relief;
@@ -28,7 +31,7 @@ use self::{
     mountains::seed_mountains,
 };
 use crate::{
-    config::{Config, RiverModel},
+    config::{Config, ReliefModel, RiverModel},
     drainage::{self, grid::SphereGrid, Drainage},
 };
 
@@ -82,6 +85,12 @@ pub struct PlanetStats {
     /// Milliseconds per stage (summed over the landmass corrections).
     pub timings_ms: std::collections::BTreeMap<String, f64>,
     pub memory_bytes: u64,
+    /// Geomorphology's measures of the planet's form (docs/geomorphology.md).
+    #[serde(flatten)]
+    pub form: crate::geomorphology::WorldMeasures,
+    /// How far the erosion ran (the eroded relief only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub erosion: Option<erosion::ErosionReport>,
 }
 
 /// A generated planet: its precomputed coarse heights, the rule that refines them to any level, and its
@@ -189,6 +198,7 @@ impl Planet {
         let mut requested = target;
         let total: f64 = weights.iter().sum();
         let mut attempt = 0;
+        let mut erosion = None;
         let drainage_model = config.river.model == RiverModel::Drainage;
         let grid = drainage_model.then(|| {
             let t = Instant::now();
@@ -215,6 +225,12 @@ impl Planet {
                     )
                 }
             };
+            let land = match &grid {
+                Some(grid) if p.relief_model == ReliefModel::Eroded => {
+                    coasts::roughen(grid, &base, &points, &land, seed64)
+                }
+                _ => land,
+            };
             let continent_share: f64 = land
                 .iter()
                 .zip(&weights)
@@ -239,7 +255,18 @@ impl Planet {
                     (mountains, None)
                 }
                 Some(grid) => {
-                    relief::raise(&mut base, grid, p, seed64);
+                    match p.relief_model {
+                        ReliefModel::Eroded => {
+                            erosion = Some(erosion::raise(
+                                &mut base,
+                                grid,
+                                p,
+                                config.river.lake_depth as f64,
+                                seed64,
+                            ))
+                        }
+                        _ => relief::raise(&mut base, grid, p, seed64),
+                    }
                     time("relief", t);
                     progress("relief");
                     let t = Instant::now();
@@ -283,6 +310,8 @@ impl Planet {
                         precomputed_cells: cells_per_patch << precomputed_level,
                         timings_ms: timings,
                         memory_bytes: 0,
+                        form: Default::default(),
+                        erosion,
                     },
                 ));
             }
@@ -302,6 +331,21 @@ impl Planet {
         let quadrant_deviations =
             lattice.quadrant_deviations(precomputed_level, config.rendering.vertices);
         stats.memory_bytes = lattice.bytes();
+        let t = Instant::now();
+        let sea_level = config.planet.sea_level_height;
+        stats.form = crate::geomorphology::measure(
+            &lattice,
+            |d| height_on(&lattice, d) > sea_level,
+            (
+                sea_level as f64,
+                config.planet.max_mountain_height as f64,
+                config.planet.radius as f64,
+            ),
+            drainage.as_ref(),
+        );
+        stats
+            .timings_ms
+            .insert("geomorphology".to_string(), ms_since(t));
         log::info!("planet: {stats:?}");
         Self {
             radius: config.planet.radius as f64,
@@ -360,19 +404,7 @@ impl Planet {
     /// The base height at a unit direction, bilinear on the precomputed lattice (finer levels add at most
     /// `rule.remaining_range(precomputed_level)` to it).
     pub fn height_at(&self, direction: DVec3) -> f32 {
-        let (face, u, v) = cube::face_of(direction);
-        let c = self.lattice.cells as f64;
-        let x = ((u + 1.0) * 0.5 * c).clamp(0.0, c);
-        let y = ((v + 1.0) * 0.5 * c).clamp(0.0, c);
-        let (i, j) = (
-            (x.floor() as u32).min(self.lattice.cells - 1),
-            (y.floor() as u32).min(self.lattice.cells - 1),
-        );
-        let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
-        let h = |di, dj| self.lattice.get(face, i + di, j + dj);
-        let bottom = h(0, 0) * (1.0 - fx) + h(1, 0) * fx;
-        let top = h(0, 1) * (1.0 - fx) + h(1, 1) * fx;
-        bottom * (1.0 - fy) + top * fy
+        height_on(&self.lattice, direction)
     }
 
     /// Lowest and highest base height any point of `patch` can have, at any level: its own range for
@@ -419,6 +451,23 @@ impl Planet {
         self.lattice
             .refined_to(self.precomputed_level, level, &self.rule, self.vertices)
     }
+}
+
+/// The height of `lattice` at a unit direction, bilinear between its points.
+fn height_on(lattice: &FaceLattice, direction: DVec3) -> f32 {
+    let (face, u, v) = cube::face_of(direction);
+    let c = lattice.cells as f64;
+    let x = ((u + 1.0) * 0.5 * c).clamp(0.0, c);
+    let y = ((v + 1.0) * 0.5 * c).clamp(0.0, c);
+    let (i, j) = (
+        (x.floor() as u32).min(lattice.cells - 1),
+        (y.floor() as u32).min(lattice.cells - 1),
+    );
+    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
+    let h = |di, dj| lattice.get(face, i + di, j + dj);
+    let bottom = h(0, 0) * (1.0 - fx) + h(1, 0) * fx;
+    let top = h(0, 1) * (1.0 - fx) + h(1, 1) * fx;
+    bottom * (1.0 - fy) + top * fy
 }
 
 /// Spreads the base lattice onto the lattice of level `to` and runs diamond-square from the base level up to it

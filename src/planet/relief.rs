@@ -27,25 +27,11 @@ const HILL_FREQUENCY: f64 = 24.0;
 /// crests of the ranges; at sea a shelf falling from the sea level to `ocean-height`. Land stays land and sea
 /// stays sea.
 pub fn raise(lattice: &mut FaceLattice, grid: &SphereGrid, planet: &PlanetConfig, seed: u64) {
-    let heights = grid.values(lattice);
     let sea_level = planet.sea_level_height as f64;
-    let land: Vec<bool> = heights.iter().map(|&h| h > sea_level).collect();
-    let coast = |is_land: bool| -> Vec<u32> {
-        (0..grid.len() as u32)
-            .filter(|&k| land[k as usize] != is_land)
-            .filter(|&k| {
-                grid.neighbours(k)
-                    .iter()
-                    .any(|&n| land[n as usize] == is_land)
-            })
-            .collect()
-    };
-    // Distance of every land node from the nearest sea node, and of every sea node from the nearest land node.
-    let (to_sea, _) = grid.nearest(&coast(true), f64::INFINITY);
-    let (to_land, _) = grid.nearest(&coast(false), f64::INFINITY);
+    let land = land_of(lattice, grid, sea_level);
+    let CoastDistances { to_sea, to_land } = CoastDistances::new(grid, &land);
     let low = planet.continent_height as f64;
     let high = planet.max_mountain_height as f64;
-    let ocean = planet.ocean_height as f64;
     let ranges_seed = rng::hash(seed, &[STREAM_RANGES]);
     let hills_seed = rng::hash(seed, &[STREAM_HILLS]);
     let raised: Vec<f64> = (0..grid.len())
@@ -61,10 +47,50 @@ pub fn raise(lattice: &mut FaceLattice, grid: &SphereGrid, planet: &PlanetConfig
                 let h = sea_level + (low - sea_level) * shore + (high - low) * rise * relief;
                 h.max(sea_level + 0.01 * (low - sea_level))
             } else {
-                let shelf = 1.0 - (-to_land[k] / SHELF_ANGLE).exp();
-                sea_level - (sea_level - ocean) * shelf
+                shelf(planet, to_land[k])
             }
         })
         .collect();
     grid.write(&raised, lattice);
+}
+
+/// Which nodes of `lattice` stand above `sea_level`.
+pub fn land_of(lattice: &FaceLattice, grid: &SphereGrid, sea_level: f64) -> Vec<bool> {
+    grid.values(lattice)
+        .iter()
+        .map(|&h| h > sea_level)
+        .collect()
+}
+
+/// The height of the sea floor `to_land` radians from the nearest land: falling from the sea level to
+/// `ocean-height` over a shelf.
+pub fn shelf(planet: &PlanetConfig, to_land: f64) -> f64 {
+    let (sea_level, ocean) = (planet.sea_level_height as f64, planet.ocean_height as f64);
+    sea_level - (sea_level - ocean) * (1.0 - (-to_land / SHELF_ANGLE).exp())
+}
+
+/// Distances along the grid (radians) of every land node from the nearest sea node, and of every sea node from
+/// the nearest land node.
+pub struct CoastDistances {
+    pub to_sea: Vec<f64>,
+    pub to_land: Vec<f64>,
+}
+
+impl CoastDistances {
+    pub fn new(grid: &SphereGrid, land: &[bool]) -> Self {
+        let coast = |is_land: bool| -> Vec<u32> {
+            (0..grid.len() as u32)
+                .filter(|&k| land[k as usize] != is_land)
+                .filter(|&k| {
+                    grid.neighbours(k)
+                        .iter()
+                        .any(|&n| land[n as usize] == is_land)
+                })
+                .collect()
+        };
+        Self {
+            to_sea: grid.nearest(&coast(true), f64::INFINITY).0,
+            to_land: grid.nearest(&coast(false), f64::INFINITY).0,
+        }
+    }
 }

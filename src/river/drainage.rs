@@ -21,7 +21,7 @@ const SYSTEM_ANGLE: f64 = 0.3;
 /// Subdivision levels in a drainage system's hull at most: its segments are a few lattice cells long already, and
 /// the extended hull's margin covers whatever finer levels add.
 const DRAINAGE_HULL_LEVELS: u32 = 1;
-/// Lattice nodes per Hermite segment.
+/// Points of a reach per Hermite segment (lattice nodes, or points of a meandering course).
 const NODES_PER_SEGMENT: usize = 2;
 
 /// The river systems of `drainage`: each mouth's tree, split where it grows beyond [`SYSTEM_ANGLE`]; the system
@@ -173,14 +173,9 @@ fn lake_system(
     enclose(config, params, (id, 0), frame, segments, (centre, centre))
 }
 
-/// Hydraulic geometry: a river's full width grows with the square root of its discharge, taken as proportional
-/// to its drainage area, from `min-width` at no area to the widest river (`starting-width x ending-factor`) at
-/// the planet's largest drainage area.
+/// A reach's full width at `area` (hydraulic geometry, [`crate::drainage::width`]).
 pub fn reach_width(config: &Config, drainage: &Drainage, area: f64) -> f32 {
-    let r = &config.river;
-    let widest = r.starting_width * r.ending_factor.max(1.0);
-    let share = (area / drainage.largest_area.max(f64::MIN_POSITIVE)).sqrt() as f32;
-    r.min_width + (widest - r.min_width) * share.clamp(0.0, 1.0)
+    crate::drainage::width(&config.river, drainage.largest_area, area)
 }
 
 /// The head of the longest chain of reaches above `root` by drainage area (the main stem).

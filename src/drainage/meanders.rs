@@ -1,0 +1,360 @@
+//! Meanders (beyond the thesis, with the eroded relief; docs/rivers.md, "Meanders"): rivers on gentle slopes
+//! wind through their valleys instead of following the lattice's straight steps. A reach's course is a
+//! sine-generated curve (Langbein and Leopold 1966), the shape of least total curvature that real meanders take:
+//! its direction swings about the valley's by `omega cos(2 pi s / lambda)` along the channel's length s, with a
+//! wavelength of eleven channel widths (bend radius about 2.3 widths; Leopold and Wolman 1960) and a swing that
+//! grows as the valley's slope falls (Schumm 1963: sinuosity rises on gentler slopes), so steep rivers stay
+//! straight. The valley's line is the reach's lattice path smoothed (Catmull-Rom); a reach holds a whole number
+//! of half wavelengths (the nearest to eleven widths), so its course crosses the valley line at both ends
+//! (confluences and mouths stay where they are), and its belt keeps within a quarter of a base cell of it, so two
+//! rivers, whose lattice paths are at least 0.7 cells apart away from their confluences, do not cross; where two
+//! courses still would (two valley lines converging on one mouth), both keep their lattice paths.
+
+use glam::DVec3;
+
+use super::ReachPath;
+
+/// Wavelength of meanders in channel widths.
+const WAVELENGTH_WIDTHS: f64 = 11.0;
+/// The swing of the course's direction on a flat valley floor (radians): a sine-generated curve with this swing
+/// has a sinuosity of 1 / J0(1.25) = 1.55 (squeezed into the belt, less).
+const FLAT_SWING: f64 = 1.25;
+/// The valley slope (drop over run, as a share of the planet's relief over its radius) at which the swing has
+/// fallen to half of the flat one. The median order-3 reach of the default planet has 0.22.
+const HALF_SWING_SLOPE: f64 = 0.5;
+/// Meanders shorter than this many base cells are left to the finer levels of detail (the thesis's subdivision).
+const SHORTEST_WAVELENGTH_CELLS: f64 = 0.5;
+/// Longer wavelengths are shortened to this: the belt must stay within [`BELT_CELLS`].
+const LONGEST_WAVELENGTH_CELLS: f64 = 1.5;
+/// Half-width of the meander belt at most, in base cells.
+const BELT_CELLS: f64 = 0.25;
+/// Points of the course per wavelength.
+const POINTS_PER_WAVELENGTH: f64 = 12.0;
+/// Integration steps per point.
+const STEPS_PER_POINT: usize = 4;
+/// Valley-line samples per lattice step.
+const VALLEY_SAMPLES: usize = 8;
+
+/// What the meanders of a planet depend on.
+pub struct MeanderScale {
+    /// A base cell, radians.
+    pub cell: f64,
+    /// The planet's radius (world units per radian).
+    pub radius: f64,
+    /// Relief over radius: the slope that [`HALF_SWING_SLOPE`] is a share of.
+    pub relief_slope: f64,
+}
+
+/// `reach` with its points along its meandering course (first and last point unchanged), beds and areas
+/// following the valley (beds never rise), or the reach as it is where it is too steep, too short or too narrow
+/// to meander at the base lattice's scale. `width(area)` is a channel's full width in world units.
+pub fn meander(reach: &ReachPath, scale: &MeanderScale, width: &impl Fn(f64) -> f64) -> ReachPath {
+    let valley = Valley::new(&reach.points);
+    let length = valley.length();
+    if reach.points.len() < 3 || length <= 0.0 {
+        return reach.clone();
+    }
+    let middle = reach.areas[reach.areas.len() / 2];
+    let wavelength = WAVELENGTH_WIDTHS * width(middle) / scale.radius;
+    if wavelength < SHORTEST_WAVELENGTH_CELLS * scale.cell {
+        return reach.clone();
+    }
+    let wavelength = wavelength.min(LONGEST_WAVELENGTH_CELLS * scale.cell);
+    let drop = (reach.beds[0] - reach.beds[reach.beds.len() - 1]) as f64;
+    let slope = drop / (length * scale.radius) / scale.relief_slope;
+    let swing = FLAT_SWING / (1.0 + (slope / HALF_SWING_SLOPE).powi(2));
+    if swing < 0.05 {
+        return reach.clone();
+    }
+    // A whole number of half wavelengths along the channel, so the course crosses the valley line at both ends.
+    let channel = length * sinuosity_of(swing);
+    let halves = (2.0 * channel / wavelength).round().max(1.0);
+    let wavelength = 2.0 * channel / halves;
+    // Integrate the sine-generated curve in the valley's frame: x along the valley, y across it.
+    let steps = (halves * 0.5 * POINTS_PER_WAVELENGTH).ceil() as usize * STEPS_PER_POINT;
+    let ds = channel / steps as f64;
+    let (mut x, mut y) = (0.0, 0.0);
+    let mut course = vec![(0.0, 0.0)];
+    for step in 0..steps {
+        let theta = swing * (std::f64::consts::TAU * (step as f64 + 0.5) * ds / wavelength).cos();
+        x += theta.cos() * ds;
+        y += theta.sin() * ds;
+        if (step + 1) % STEPS_PER_POINT == 0 {
+            course.push((x, y));
+        }
+    }
+    // Onto the valley's ends exactly (the integration leaves a little drift), and within the belt.
+    let (end_x, end_y) = *course.last().expect("not empty");
+    // Near its ends the course eases onto the valley line over half a wavelength, so a tributary meets its main
+    // stem along its valley instead of swinging across the other's course.
+    let ease = |x: f64| {
+        let t = (x.min(length - x) / (0.5 * wavelength)).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    };
+    let course: Vec<(f64, f64)> = course
+        .iter()
+        .map(|&(x, y)| {
+            let x = x * length / end_x;
+            (x, (y - end_y * x / length) * ease(x))
+        })
+        .collect();
+    let widest = course.iter().map(|c| c.1.abs()).fold(0.0, f64::max);
+    let squeeze = (BELT_CELLS * scale.cell / widest.max(1e-12)).min(1.0);
+    let points: Vec<DVec3> = course
+        .iter()
+        .enumerate()
+        .map(|(i, &(x, y))| {
+            if i == 0 {
+                return reach.points[0];
+            }
+            if i == course.len() - 1 {
+                return *reach.points.last().expect("not empty");
+            }
+            let (at, along) = valley.at(x);
+            let across = at.cross(along).normalize_or_zero();
+            (at + across * y * squeeze).normalize()
+        })
+        .collect();
+    // Beds and areas by the position along the valley, between the lattice nodes around it.
+    let (beds, areas) = course
+        .iter()
+        .map(|&(x, _)| {
+            let (i, t) = valley.node_at(x);
+            let j = (i + 1).min(reach.beds.len() - 1);
+            let bed = reach.beds[i] + (reach.beds[j] - reach.beds[i]) * t as f32;
+            (bed, reach.areas[i] + (reach.areas[j] - reach.areas[i]) * t)
+        })
+        .unzip();
+    ReachPath {
+        points,
+        beds: monotone(beds),
+        areas,
+        strahler: reach.strahler,
+        downstream: reach.downstream,
+    }
+}
+
+/// The reaches of `lattice` with meandering courses ([`meander`]), except that where two courses would cross
+/// (near a shared mouth, where two valley lines converge) both keep their lattice paths, which never cross.
+pub fn meander_all(
+    lattice: &[ReachPath],
+    scale: &MeanderScale,
+    width: impl Fn(f64) -> f64,
+) -> Vec<ReachPath> {
+    let mut reaches: Vec<ReachPath> = lattice.iter().map(|r| meander(r, scale, &width)).collect();
+    loop {
+        let crossing = crossing_reaches(&reaches);
+        if crossing.is_empty() {
+            return reaches;
+        }
+        for r in crossing {
+            reaches[r] = lattice[r].clone();
+        }
+    }
+}
+
+/// Reaches whose course crosses another's: segments (great-circle arcs) whose ends lie on opposite sides of each
+/// other's circle, found through a hash of small cells; segments that share an end (a confluence) do not count.
+pub fn crossing_reaches(reaches: &[ReachPath]) -> std::collections::BTreeSet<usize> {
+    const CELL: f64 = 0.004;
+    let key = |p: DVec3| (p / CELL).floor().as_ivec3();
+    let mut cells: std::collections::HashMap<glam::IVec3, Vec<(usize, usize)>> = Default::default();
+    for (r, reach) in reaches.iter().enumerate() {
+        for i in 0..reach.points.len().saturating_sub(1) {
+            let (a, b) = (key(reach.points[i]), key(reach.points[i + 1]));
+            cells.entry(a).or_default().push((r, i));
+            if b != a {
+                cells.entry(b).or_default().push((r, i));
+            }
+        }
+    }
+    let segment = |(r, i): (usize, usize)| (reaches[r].points[i], reaches[r].points[i + 1]);
+    let mut crossing = std::collections::BTreeSet::new();
+    for list in cells.values() {
+        for (x, &s) in list.iter().enumerate() {
+            for &t in &list[x + 1..] {
+                let ((a, b), (c, d)) = (segment(s), segment(t));
+                if s.0 == t.0 || a == c || a == d || b == c || b == d {
+                    continue;
+                }
+                let apart = |n: DVec3, p: DVec3, q: DVec3| n.dot(p) * n.dot(q) < 0.0;
+                if apart(a.cross(b), c, d) && apart(c.cross(d), a, b) && a.dot(c) > 0.0 {
+                    crossing.insert(s.0);
+                    crossing.insert(t.0);
+                }
+            }
+        }
+    }
+    crossing
+}
+
+/// Beds that never rise downstream (float rounding in the interpolation could).
+fn monotone(mut beds: Vec<f32>) -> Vec<f32> {
+    for i in 1..beds.len() {
+        beds[i] = beds[i].min(beds[i - 1]);
+    }
+    beds
+}
+
+/// The sinuosity of a sine-generated curve of swing `omega`: 1 / J0(omega), the Bessel function as the mean of
+/// cos(omega cos phi) over a period.
+fn sinuosity_of(omega: f64) -> f64 {
+    const N: usize = 64;
+    let mean = (0..N)
+        .map(|i| (omega * (std::f64::consts::TAU * (i as f64 + 0.5) / N as f64).cos()).cos())
+        .sum::<f64>()
+        / N as f64;
+    1.0 / mean
+}
+
+/// A reach's valley line: its lattice path smoothed by a Catmull-Rom spline, sampled by arc length.
+struct Valley {
+    /// Points along the line, [`VALLEY_SAMPLES`] per lattice step.
+    samples: Vec<DVec3>,
+    /// Arc length (radians) at each sample.
+    lengths: Vec<f64>,
+}
+
+impl Valley {
+    fn new(nodes: &[DVec3]) -> Self {
+        let n = nodes.len();
+        let node = |i: isize| nodes[i.clamp(0, n as isize - 1) as usize];
+        let mut samples = Vec::with_capacity(n * VALLEY_SAMPLES);
+        for i in 0..n.saturating_sub(1) {
+            let (p0, p1, p2, p3) = (
+                node(i as isize - 1),
+                node(i as isize),
+                node(i as isize + 1),
+                node(i as isize + 2),
+            );
+            for k in 0..VALLEY_SAMPLES {
+                let t = k as f64 / VALLEY_SAMPLES as f64;
+                let (t2, t3) = (t * t, t * t * t);
+                let p = 0.5
+                    * (2.0 * p1
+                        + (p2 - p0) * t
+                        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+                        + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t3);
+                samples.push(p.normalize());
+            }
+        }
+        samples.extend(nodes.last());
+        let mut lengths = vec![0.0];
+        for w in samples.windows(2) {
+            lengths.push(lengths.last().expect("not empty") + w[0].angle_between(w[1]));
+        }
+        Self { samples, lengths }
+    }
+
+    fn length(&self) -> f64 {
+        *self.lengths.last().expect("not empty")
+    }
+
+    /// The sample segment holding arc length `x`, and the share of the way along it.
+    fn segment(&self, x: f64) -> (usize, f64) {
+        let i = self
+            .lengths
+            .partition_point(|&l| l <= x)
+            .clamp(1, self.lengths.len() - 1)
+            - 1;
+        let span = self.lengths[i + 1] - self.lengths[i];
+        let t = if span > 0.0 {
+            ((x - self.lengths[i]) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (i, t)
+    }
+
+    /// The point at arc length `x` and the line's direction there.
+    fn at(&self, x: f64) -> (DVec3, DVec3) {
+        let (i, t) = self.segment(x);
+        let (a, b) = (self.samples[i], self.samples[i + 1]);
+        ((a + (b - a) * t).normalize(), (b - a).normalize_or_zero())
+    }
+
+    /// The lattice node before arc length `x`, and the share of the way to the next.
+    fn node_at(&self, x: f64) -> (usize, f64) {
+        let (i, t) = self.segment(x);
+        let position = (i as f64 + t) / VALLEY_SAMPLES as f64;
+        (position.floor() as usize, position.fract())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn straight_reach(steps: usize, drop: f32) -> ReachPath {
+        let cell = std::f64::consts::FRAC_PI_2 / 128.0;
+        let points: Vec<DVec3> = (0..=steps)
+            .map(|i| DVec3::new((i as f64 * cell).cos(), (i as f64 * cell).sin(), 0.0))
+            .collect();
+        let beds = (0..=steps)
+            .map(|i| 10.0 - drop * i as f32 / steps as f32)
+            .collect();
+        ReachPath {
+            points,
+            beds,
+            areas: vec![1e-3; steps + 1],
+            strahler: 3,
+            downstream: None,
+        }
+    }
+
+    fn scale() -> MeanderScale {
+        MeanderScale {
+            cell: std::f64::consts::FRAC_PI_2 / 128.0,
+            radius: 1024.0,
+            relief_slope: 16.0 / 1024.0,
+        }
+    }
+
+    fn sinuosity(r: &ReachPath) -> f64 {
+        let length: f64 = r.points.windows(2).map(|w| w[0].angle_between(w[1])).sum();
+        length / r.points[0].angle_between(*r.points.last().unwrap())
+    }
+
+    #[test]
+    fn a_gentle_river_meanders_within_its_belt_and_keeps_its_ends() {
+        let reach = straight_reach(40, 0.2);
+        let m = meander(&reach, &scale(), &|_| 1.0);
+        assert!(sinuosity(&m) > 1.3, "{}", sinuosity(&m));
+        assert_eq!(m.points[0], reach.points[0]);
+        assert_eq!(m.points.last(), reach.points.last());
+        // The belt: every point within a quarter cell of the straight valley (the plane z = 0).
+        let belt = m.points.iter().map(|p| p.z.abs()).fold(0.0, f64::max);
+        assert!(belt <= 0.25 * scale().cell * 1.01, "{belt}");
+        assert!(m.beds.windows(2).all(|w| w[1] <= w[0]));
+        assert_eq!(m.beds[0], reach.beds[0]);
+    }
+
+    #[test]
+    fn crossing_courses_are_found_and_courses_that_meet_at_a_confluence_are_not() {
+        let at = |x: f64, y: f64| DVec3::new(1.0, x, y).normalize();
+        let path = |points: Vec<DVec3>| ReachPath {
+            beds: vec![0.0; points.len()],
+            areas: vec![1.0; points.len()],
+            points,
+            strahler: 1,
+            downstream: None,
+        };
+        let across = path(vec![at(0.0, -0.01), at(0.0, 0.0005), at(0.0, 0.01)]);
+        let along = path(vec![at(-0.01, 0.0), at(0.0005, 0.0), at(0.01, 0.0)]);
+        let joining = path(vec![at(-0.01, -0.01), at(0.0, 0.0005)]);
+        assert_eq!(
+            crossing_reaches(&[across.clone(), along]),
+            [0, 1].into_iter().collect()
+        );
+        assert!(crossing_reaches(&[across, joining]).is_empty());
+    }
+
+    #[test]
+    fn a_steep_river_stays_straight_and_a_creek_is_left_to_finer_levels() {
+        // A drop of 16 over 40 cells (500 units) is a slope of 0.031, twice the relief slope.
+        let steep = meander(&straight_reach(40, 16.0), &scale(), &|_| 1.0);
+        assert!(sinuosity(&steep) < 1.01, "{}", sinuosity(&steep));
+        let creek = meander(&straight_reach(40, 0.2), &scale(), &|_| 0.1);
+        assert_eq!(creek.points.len(), 41);
+    }
+}
