@@ -17,13 +17,17 @@ use riverplanet::{
 const LEVEL: u8 = 6;
 
 /// How far the water may stand above the drawn terrain beside it, in height units. The kernel averages the river
-/// bed over the influence distance (Procedures 4-5), so where a river falls steeply (towards a coast) the water
-/// at its centre stands above banks a few units up- or downstream; on config/planet.xml seed 1 that is at most
-/// 0.49. The thesis's rivers, which cross the relief, stand up to 2.88 above their banks on the same planet.
-const BANK_TOLERANCE: f64 = 0.75;
+/// bed over the influence distance (Procedures 4-5), so where a river falls steeply its water at the centre stands
+/// above banks a few units up- or downstream. On config/planet.xml seed 1 (eroded relief, whose heads are steep,
+/// as concave profiles are) that is at most 0.90, at fewer than one point in ten thousand (0.17 at the 99.99th
+/// percentile, 0.11 at the 99.9th); the carved relief measured 0.49 at most. The thesis's rivers, which cross the
+/// relief, stand up to 2.88 above their banks on the same planet.
+const BANK_TOLERANCE: f64 = 1.0;
+/// The 99.9th percentile of the same, at most.
+const BANK_TOLERANCE_999: f64 = 0.2;
 /// How much the water may rise from one checked point to the next downstream (the kernel's averaging over
-/// samples of falling beds; 0.056 at most measured).
-const RISE_TOLERANCE: f64 = 0.1;
+/// samples of falling beds; 0.198 at most measured on the eroded relief's steep heads, 0.056 on the carved).
+const RISE_TOLERANCE: f64 = 0.25;
 
 struct Findings {
     /// The largest height of water above the drawn terrain beside the river.
@@ -35,6 +39,8 @@ struct Findings {
     upstream_flows: usize,
     centres: usize,
     checked: usize,
+    /// Every checked height of the water above the drawn terrain beside the river.
+    excesses: Vec<f64>,
 }
 
 /// Checks the middle of every segment of every river at [`LEVEL`].
@@ -48,6 +54,7 @@ fn survey(world: &World) -> Findings {
         upstream_flows: 0,
         centres: 0,
         checked: 0,
+        excesses: Vec::new(),
     };
     for system in &world.network.systems {
         for segment in &system.segments {
@@ -122,6 +129,7 @@ fn survey(world: &World) -> Findings {
                             continue;
                         }
                         findings.worst_excess = findings.worst_excess.max(water - surface);
+                        findings.excesses.push(water - surface);
                         findings.checked += 1;
                     }
                 }
@@ -141,7 +149,9 @@ fn world(model: RiverModel) -> World {
 #[test]
 fn drained_rivers_run_below_their_banks_never_rise_and_flow_downstream_at_level_6() {
     let world = world(RiverModel::Drainage);
-    let f = survey(&world);
+    let mut f = survey(&world);
+    f.excesses.sort_by(f64::total_cmp);
+    let quantile = |q: f64| f.excesses[((f.excesses.len() - 1) as f64 * q) as usize];
     println!(
         "{} points beside rivers: water at most {:.4} above the drawn terrain, rising at most {:.4}; {} of {} \
          centres flow otherwise than downstream",
@@ -155,10 +165,20 @@ fn drained_rivers_run_below_their_banks_never_rise_and_flow_downstream_at_level_
         f.upstream_flows,
         f.centres
     );
+    println!(
+        "water above its banks: {:.4} at the 99.9th percentile, {:.4} at the 99.99th",
+        quantile(0.999),
+        quantile(0.9999)
+    );
     assert!(
         f.worst_excess <= BANK_TOLERANCE,
         "water {} above its banks",
         f.worst_excess
+    );
+    assert!(
+        quantile(0.999) <= BANK_TOLERANCE_999,
+        "water {} above its banks at the 99.9th percentile",
+        quantile(0.999)
     );
     assert!(
         f.worst_rise <= RISE_TOLERANCE,
@@ -179,8 +199,11 @@ fn the_thesis_rivers_fail_the_bank_check() {
 }
 
 /// Lake water: at the lake's level, except where a river flows in and the kernel's average over the influence
-/// distance lifts the water towards the river's (0.17 at most on config/planet.xml seed 1).
-const LAKE_TOLERANCE: f64 = 0.2;
+/// distance lifts the water towards the river's (0.26 at most on config/planet.xml seed 1, whose lake basins are
+/// a few cells wide, so many lake points lie within the influence distance of an inflow).
+const LAKE_TOLERANCE: f64 = 0.3;
+/// The median lake point's water from the level, at most (0.005 measured).
+const LAKE_MEDIAN_TOLERANCE: f64 = 0.01;
 
 #[test]
 fn lakes_are_drawn_as_water_at_their_level() {
@@ -212,7 +235,7 @@ fn lakes_are_drawn_as_water_at_their_level() {
         deviations.len()
     );
     assert!(
-        median <= 1e-3,
+        median <= LAKE_MEDIAN_TOLERANCE,
         "lake water {median} off its level at the median"
     );
     assert!(worst <= LAKE_TOLERANCE, "lake water {worst} off its level");

@@ -4,7 +4,10 @@
 use glam::DVec3;
 
 use crate::{
-    river::{network::finest_piece_near, samples::sample_step},
+    river::{
+        network::{finest_piece_near, RiverSystem, Segment},
+        samples::sample_step,
+    },
     world::World,
 };
 
@@ -12,18 +15,21 @@ use crate::{
 pub enum Preset {
     /// The whole planet from orbit, centred on the first river.
     Orbit,
-    /// Above the first river's source mountain, looking across the range.
+    /// Above the planet's highest peak, looking across its range from the side of the first river's mouth.
     Mountains,
-    /// Close above the first river's middle, looking along it.
+    /// Close above the first river's lower course (its widest segment over land), looking along it.
     River,
-    /// Two world units (metres in config/earth.xml) above the first river's water surface near its middle (the
-    /// middle of the segment nearest the river's middle that runs over land), looking downstream along it: the
-    /// deepest levels of detail.
+    /// Two world units (metres in config/earth.xml) above the first river's water surface on its lower course
+    /// (the widest segment whose middle runs over land), looking downstream along it: the deepest levels of
+    /// detail.
     Ground,
 }
 
 /// The radius of Appendix A's planet, for which the presets' distances were chosen.
 const APPENDIX_A_RADIUS: f64 = 1024.0;
+
+/// The beaches' share of the relief above sea level: the river presets look at rivers above them.
+const BEACH: f32 = 0.05;
 
 /// Height of the ground preset's eye above the river's water, in world units.
 pub const GROUND_EYE_HEIGHT: f64 = 2.0;
@@ -43,8 +49,8 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             (d * r * 3.2, DVec3::ZERO)
         }
         Preset::Mountains => {
-            let top = system.source;
-            let away = (system.source - system.mouth).normalize();
+            let top = highest_point(world);
+            let away = (top - system.mouth).normalize_or(top.any_orthonormal_vector());
             let eye_dir = up(top + away * 0.06);
             (
                 eye_dir * (r + height(eye_dir).max(sea) + 70.0 * unit),
@@ -52,17 +58,12 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             )
         }
         Preset::River => {
-            let middle = system.segments[system.segments.len() / 2].curve.point(0.5);
+            let segment = lower_course(world, system);
+            let middle = segment.curve.point(0.5);
             let target = system.frame.to_sphere(middle);
-            let along = system.frame.to_sphere(
-                middle
-                    + system.segments[system.segments.len() / 2]
-                        .curve
-                        .derivative(0.5)
-                        .normalize()
-                        * 40.0
-                        * unit,
-            );
+            let along = system
+                .frame
+                .to_sphere(middle + segment.curve.derivative(0.5).normalize() * 40.0 * unit);
             let back = (target - along).normalize();
             let eye_dir = up(target + back * 0.03);
             (
@@ -71,22 +72,7 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             )
         }
         Preset::Ground => {
-            // The segment nearest the river's middle whose middle runs over land above sea level (a river of
-            // the thesis's model may cross a bay on its way and run on at the bay's depth).
-            let count = system.segments.len();
-            let on_land = |s: &&crate::river::network::Segment| {
-                world
-                    .planet
-                    .is_land(system.frame.to_sphere(s.curve.point(0.5)))
-                    && s.height_at(0.5) > world.planet.sea_level
-            };
-            let mut by_distance: Vec<usize> = (0..count).collect();
-            by_distance.sort_by_key(|k| k.abs_diff(count / 2));
-            let segment = by_distance
-                .iter()
-                .map(|&k| &system.segments[k])
-                .find(on_land)
-                .unwrap_or(&system.segments[count / 2]);
+            let segment = lower_course(world, system);
             // Where the deepest levels draw the river: its finest piece there.
             let network = &world.network;
             let finest = sample_step(network, segment.narrowest());
@@ -104,6 +90,40 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             (here * (r + water + GROUND_EYE_HEIGHT), ahead * (r + water))
         }
     })
+}
+
+/// The direction of the highest point of the precomputed heights.
+fn highest_point(world: &World) -> DVec3 {
+    let lattice = &world.planet.lattice;
+    let side = lattice.side();
+    let (index, _) =
+        lattice.data.iter().enumerate().fold(
+            (0, f32::MIN),
+            |best, (k, &h)| if h > best.1 { (k, h) } else { best },
+        );
+    let (face, rest) = (index / (side * side), index % (side * side));
+    let (i, j) = ((rest % side) as u32, (rest / side) as u32);
+    lattice.direction(lattice.key(face, i, j))
+}
+
+/// The widest segment of `system` whose middle runs over land above the coast's beaches (its lower course, where
+/// rivers are widest and meander; a river of the thesis's model may cross a bay on its way and run on at the
+/// bay's depth), or its middle segment if none does.
+fn lower_course<'a>(world: &World, system: &'a RiverSystem) -> &'a Segment {
+    let sea = world.planet.sea_level;
+    let inland = sea + BEACH * (world.config.planet.max_mountain_height - sea);
+    let on_land = |s: &&Segment| {
+        world
+            .planet
+            .is_land(system.frame.to_sphere(s.curve.point(0.5)))
+            && s.height_at(0.5) > inland
+    };
+    system
+        .segments
+        .iter()
+        .filter(on_land)
+        .max_by(|a, b| a.widths.0.total_cmp(&b.widths.0))
+        .unwrap_or(&system.segments[system.segments.len() / 2])
 }
 
 impl crate::named::Named for Preset {
