@@ -191,7 +191,9 @@ fn bad_configuration_exits_with_2_from_every_command_and_names_the_element() {
 #[test]
 fn the_ground_preset_reaches_deep_levels_made_on_demand() {
     // Two units above the first river's water with max-level-of-detail 24: the patches under the camera are
-    // refined far beyond the precomputed level 4 (the thesis's precomputed pyramid stopped at 6).
+    // refined far beyond the precomputed level 4 (the thesis's precomputed pyramid stopped at 6). By the thesis's
+    // Eq. 6.1, which refines by distance alone (the screen-space rule stops where the surface is smooth enough for
+    // the image: level 10 over the eroded relief's floodplain at this size).
     let dir = temp_dir("ground");
     let config = dir.join("deep.xml");
     std::fs::write(
@@ -202,7 +204,16 @@ fn the_ground_preset_reaches_deep_levels_made_on_demand() {
     .unwrap();
     let out = riverplanet()
         .args([
-            "render", "--seed", "1", "--preset", "ground", "--size", "160x90", "--config",
+            "render",
+            "--seed",
+            "1",
+            "--preset",
+            "ground",
+            "--size",
+            "160x90",
+            "--lod-rule",
+            "distance",
+            "--config",
         ])
         .arg(&config)
         .arg("--out")
