@@ -46,7 +46,7 @@ const BELT_FLOOR: f64 = 0.72;
 /// Plateaus: broad uplifted regions where a smooth field stands high.
 const PLATEAU_FREQUENCY: f64 = 1.6;
 /// Uplift of the lowlands, of plateaus and of the belts' crests, relative to each other.
-const LOWLAND_UPLIFT: f64 = 0.1;
+const LOWLAND_UPLIFT: f64 = 0.08;
 const PLATEAU_UPLIFT: f64 = 0.35;
 const BELT_UPLIFT: f64 = 1.0;
 /// Angle over which uplift grows from the coast inland (radians): coastal plains stay low.
