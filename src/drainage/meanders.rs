@@ -142,13 +142,20 @@ pub fn meander_all(
     width: impl Fn(f64) -> f64,
 ) -> Vec<ReachPath> {
     let mut reaches: Vec<ReachPath> = lattice.iter().map(|r| meander(r, scale, &width)).collect();
+    let mut meandering = vec![true; reaches.len()];
     loop {
-        let crossing = crossing_reaches(&reaches);
+        // Only meandering reaches can be given back their lattice paths (lattice paths that cross each other,
+        // where the routing could not turn a diagonal, stay as they are).
+        let crossing: Vec<usize> = crossing_reaches(&reaches)
+            .into_iter()
+            .filter(|&r| meandering[r])
+            .collect();
         if crossing.is_empty() {
             return reaches;
         }
         for r in crossing {
             reaches[r] = lattice[r].clone();
+            meandering[r] = false;
         }
     }
 }

@@ -213,8 +213,8 @@ fn lakes(
     (lakes, lake_of)
 }
 
-/// Least-squares slope of y over x.
-fn slope(points: &[(f64, f64)]) -> f64 {
+/// Least-squares slope of y over x (NaN with fewer than two distinct x).
+pub fn slope(points: &[(f64, f64)]) -> f64 {
     let n = points.len() as f64;
     let (sx, sy) = points
         .iter()

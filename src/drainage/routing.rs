@@ -26,9 +26,8 @@ pub struct Routing {
     pub crossing: usize,
 }
 
-/// Fills the depressions of `heights` and sends every land node to its steepest lower neighbour on the filled
-/// surface; `area` is left empty ([`accumulate`]). Diagonal flows may cross (landscape evolution does not mind).
-pub fn steepest_descent(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
+/// Routes `heights` (one per grid node) to the sea: nodes at or below `sea_level` are outlets.
+pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
     let n = grid.len();
     let span = heights
         .iter()
@@ -71,27 +70,15 @@ pub fn steepest_descent(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> R
             false => steepest_lower(grid, &filled, k, &[]),
         })
         .collect();
-    Routing {
+    let mut routing = Routing {
         filled,
         receiver,
         upstream_first: downstream_first.into_iter().rev().collect(),
         area: Vec::new(),
         turned: 0,
         crossing: 0,
-    }
-}
-
-/// Routes `heights` (one per grid node) to the sea: nodes at or below `sea_level` are outlets. No two flows cross
-/// a lattice quad's diagonals ([`uncross_diagonals`]).
-pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
-    let mut routing = steepest_descent(grid, heights, sea_level);
+    };
     uncross_diagonals(grid, &mut routing);
-    accumulate(grid, &mut routing);
-    routing
-}
-
-/// Drainage area of every node: its own area plus everything that drains through it.
-pub fn accumulate(grid: &SphereGrid, routing: &mut Routing) {
     let mut area = grid.areas.clone();
     for &k in &routing.upstream_first {
         let r = routing.receiver[k as usize];
@@ -100,6 +87,7 @@ pub fn accumulate(grid: &SphereGrid, routing: &mut Routing) {
         }
     }
     routing.area = area;
+    routing
 }
 
 /// The neighbour of `node` with the steepest descent on `filled` (drop over angle), leaving out `except`;

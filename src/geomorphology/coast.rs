@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::planet::direction_at;
+use crate::{drainage::rivers::slope, planet::direction_at};
 
 /// Width of the mask (pixels; height half of it): a pixel is 0.088 degrees, half the precomputed lattice's cell.
 pub const MASK_WIDTH: usize = 4096;
@@ -117,7 +117,7 @@ impl LandMask {
                 ((s as f64).ln(), (boxes.len() as f64).ln())
             })
             .collect();
-        -least_squares_slope(&points)
+        -slope(&points)
     }
 
     /// The coastlines as closed or open polylines of unit directions (marching squares on the mask; a line ends
@@ -245,18 +245,6 @@ pub fn longest_straight(line: &[DVec3], tolerance: f64) -> f64 {
         }
     }
     longest
-}
-
-/// The least-squares slope of y over x.
-pub fn least_squares_slope(points: &[(f64, f64)]) -> f64 {
-    let n = points.len() as f64;
-    let (mx, my) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(sxy, sxx), (x, y)| {
-        (sxy + (x - mx) * (y - my), sxx + (x - mx) * (x - mx))
-    });
-    sxy / sxx
 }
 
 #[cfg(test)]

@@ -82,7 +82,7 @@ pub fn concavity(reaches: &[ReachPath], radius: f64) -> f64 {
     if points.len() < 2 {
         return f64::NAN;
     }
-    -super::coast::least_squares_slope(&points)
+    -crate::drainage::rivers::slope(&points)
 }
 
 /// The median of `values` (NaN when empty).

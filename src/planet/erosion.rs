@@ -269,7 +269,7 @@ fn smoothstep(lo: f64, hi: f64, x: f64) -> f64 {
 }
 
 /// The `q` quantile of `values` (0 when empty).
-pub fn quantile(values: impl Iterator<Item = f64>, q: f64) -> f64 {
+fn quantile(values: impl Iterator<Item = f64>, q: f64) -> f64 {
     let mut v: Vec<f64> = values.collect();
     if v.is_empty() {
         return 0.0;
