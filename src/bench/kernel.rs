@@ -11,9 +11,9 @@ use super::{median, path::Flight, Threads};
 use crate::{
     gpu::{bindless::Bindless, Context, GpuError},
     kernel::{
-        cpu,
+        cpu, diff_by_output,
         gpu::{run_batch_into, BatchOutputs, KernelTuning, KernelVariant, RiverKernel},
-        max_abs_diff, KernelParams, PatchJob, RiverSample, RiverTexel,
+        KernelParams, OutputDiff, PatchJob, RiverSample, RiverTexel,
     },
     planet::cube::PatchId,
     river::samples::{patch_samples, PatchFrame, PatchSamples},
@@ -39,6 +39,24 @@ pub struct Variants {
     pub cpu_rayon: VariantTiming,
     pub gpu_simple: VariantTiming,
     pub gpu_tiled: VariantTiming,
+}
+
+/// Per-output differences of each GPU variant to the CPU reference (the worst over the repetitions).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct DiffsByVariant {
+    pub gpu_simple: Vec<OutputDiff>,
+    pub gpu_tiled: Vec<OutputDiff>,
+}
+
+impl DiffsByVariant {
+    /// The largest difference of any output and variant.
+    pub fn max(&self) -> f32 {
+        self.gpu_simple
+            .iter()
+            .chain(&self.gpu_tiled)
+            .map(|d| d.max_abs_diff)
+            .fold(0.0, f32::max)
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -70,6 +88,8 @@ pub struct KernelReport {
     pub max_abs_diff: f32,
     /// `max_abs_diff` relative to the height range.
     pub relative_diff: f32,
+    /// The largest difference to the CPU reference per output and GPU variant, with where it is.
+    pub max_abs_diff_by_output: DiffsByVariant,
     pub repetitions: usize,
     pub tuning: KernelTuning,
     pub threads: Threads,
@@ -180,7 +200,7 @@ impl VariantRunner {
     }
 
     /// Times CPU single-thread, CPU rayon, GPU simple and GPU tiled; `repetitions` runs each (after one warm-up
-    /// run for the GPU). Returns the timings, the CPU reference output, and the largest difference to it.
+    /// run for the GPU). Returns the timings, the CPU reference output, and the differences to it.
     pub fn measure(
         &mut self,
         ctx: &Context,
@@ -188,7 +208,7 @@ impl VariantRunner {
         params: &KernelParams,
         repetitions: usize,
         warm_up: bool,
-    ) -> Result<(Variants, Vec<Vec<RiverTexel>>, f32), GpuError> {
+    ) -> Result<(Variants, Vec<Vec<RiverTexel>>, DiffsByVariant), GpuError> {
         let n = self.kernel.grid_size;
         let repetitions = repetitions.max(1);
         let time = |f: &mut dyn FnMut()| {
@@ -203,8 +223,7 @@ impl VariantRunner {
         let cpu_rayon: Vec<f64> = (0..repetitions)
             .map(|_| time(&mut || drop(cpu::compute_patches_rayon(jobs, n, params))))
             .collect();
-        let mut max_diff = 0.0f32;
-        let mut gpu = |variant| -> Result<VariantTiming, GpuError> {
+        let gpu = |variant, diffs: &mut Vec<OutputDiff>| -> Result<VariantTiming, GpuError> {
             let run = || {
                 let (bindless, outputs) = (&self.bindless, &self.outputs);
                 run_batch_into(
@@ -227,7 +246,16 @@ impl VariantRunner {
                 let result = run()?;
                 end_to_end.push(t.elapsed().as_secs_f64() * 1e3);
                 kernel_ms.push(result.timings.iter().map(|s| s.ms).sum());
-                max_diff = max_diff.max(max_abs_diff(&reference, &result.texels));
+                let these = diff_by_output(&reference, &result.texels, n);
+                if diffs.is_empty() {
+                    *diffs = these;
+                } else {
+                    for (worst, d) in diffs.iter_mut().zip(these) {
+                        if d.max_abs_diff > worst.max_abs_diff {
+                            *worst = d;
+                        }
+                    }
+                }
             }
             Ok(VariantTiming {
                 kernel_ms: median(&kernel_ms),
@@ -235,8 +263,9 @@ impl VariantRunner {
                 runs_ms: kernel_ms,
             })
         };
-        let gpu_simple = gpu(KernelVariant::Simple)?;
-        let gpu_tiled = gpu(KernelVariant::Tiled)?;
+        let mut diffs = DiffsByVariant::default();
+        let gpu_simple = gpu(KernelVariant::Simple, &mut diffs.gpu_simple)?;
+        let gpu_tiled = gpu(KernelVariant::Tiled, &mut diffs.gpu_tiled)?;
         let cpu = |runs: Vec<f64>| VariantTiming {
             kernel_ms: median(&runs),
             end_to_end_ms: None,
@@ -248,7 +277,7 @@ impl VariantRunner {
             gpu_simple,
             gpu_tiled,
         };
-        Ok((variants, reference, max_diff))
+        Ok((variants, reference, diffs))
     }
 
     pub fn destroy(self, ctx: &Context) {
@@ -276,7 +305,8 @@ pub fn kernel_bench(
     let mut runner = VariantRunner::new(ctx, jobs.len(), n, tuning)?;
     let measured = runner.measure(ctx, &jobs, &params, repetitions, true);
     runner.destroy(ctx);
-    let (variants, reference, max_abs_diff) = measured?;
+    let (variants, reference, diffs) = measured?;
+    let max_abs_diff = diffs.max();
     let heights = reference.iter().flatten().map(|t| t.terrain_height);
     let height_range = heights.fold([f32::MAX, f32::MIN], |[lo, hi], h| [lo.min(h), hi.max(h)]);
     let ratios = Ratios {
@@ -312,6 +342,7 @@ pub fn kernel_bench(
         height_range,
         max_abs_diff,
         relative_diff: max_abs_diff / (height_range[1] - height_range[0]).max(1e-6),
+        max_abs_diff_by_output: diffs,
         repetitions,
         tuning,
         threads: Threads::current(),

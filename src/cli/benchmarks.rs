@@ -75,6 +75,17 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 report.relative_diff,
                 report.height_range
             );
+            for (variant, diffs) in [
+                ("gpu simple", &report.max_abs_diff_by_output.gpu_simple),
+                ("gpu tiled", &report.max_abs_diff_by_output.gpu_tiled),
+            ] {
+                for d in diffs.iter().filter(|d| d.max_abs_diff > 0.0) {
+                    println!(
+                        "  {variant:<12} {:<15} max |diff| {:.3e} at patch {} vertex {:?}: cpu {} gpu {}",
+                        d.output, d.max_abs_diff, d.patch, d.vertex, d.expected, d.actual
+                    );
+                }
+            }
             check_validation(&ctx)?;
             if let Some(path) = json {
                 write_json(&path, &report)?;

@@ -100,23 +100,97 @@ impl<'a> PatchJob<'a> {
     }
 }
 
+/// The names of a texel's outputs, in [`RiverTexel::outputs`] order.
+pub const OUTPUT_NAMES: [&str; 7] = [
+    "terrain_height",
+    "lerp_factor",
+    "water_height",
+    "min_distance",
+    "river_width",
+    "flow_x",
+    "flow_y",
+];
+
+impl RiverTexel {
+    /// The outputs as one array, in [`OUTPUT_NAMES`] order.
+    pub fn outputs(&self) -> [f32; 7] {
+        [
+            self.terrain_height,
+            self.lerp_factor,
+            self.water_height,
+            self.min_distance,
+            self.river_width,
+            self.flow[0],
+            self.flow[1],
+        ]
+    }
+}
+
+/// The largest difference of one output between two sets of patches, and where it is: which output, patch and
+/// vertex, and both values (so a mismatch on one device can be traced to its case).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct OutputDiff {
+    pub output: &'static str,
+    pub max_abs_diff: f32,
+    pub patch: usize,
+    pub vertex: [u32; 2],
+    pub expected: f32,
+    pub actual: f32,
+}
+
+/// The largest difference per output between `expected` (the CPU reference) and `actual`, patches of `n x n`
+/// texels in row-major order.
+pub fn diff_by_output(
+    expected: &[Vec<RiverTexel>],
+    actual: &[Vec<RiverTexel>],
+    n: u32,
+) -> Vec<OutputDiff> {
+    let mut worst: Vec<OutputDiff> = OUTPUT_NAMES
+        .iter()
+        .map(|&output| OutputDiff {
+            output,
+            max_abs_diff: 0.0,
+            patch: 0,
+            vertex: [0, 0],
+            expected: 0.0,
+            actual: 0.0,
+        })
+        .collect();
+    for (patch, (a, b)) in expected.iter().zip(actual).enumerate() {
+        for (k, (x, y)) in a.iter().zip(b).enumerate() {
+            for (w, (e, g)) in worst
+                .iter_mut()
+                .zip(x.outputs().into_iter().zip(y.outputs()))
+            {
+                let d = (e - g).abs();
+                // NaN on either side counts as the largest difference.
+                if d > w.max_abs_diff || (d.is_nan() && !w.max_abs_diff.is_nan()) {
+                    *w = OutputDiff {
+                        max_abs_diff: d,
+                        patch,
+                        vertex: [k as u32 % n, k as u32 / n],
+                        expected: e,
+                        actual: g,
+                        ..*w
+                    };
+                }
+            }
+        }
+    }
+    worst
+}
+
 /// The largest difference in any output (the five and the flow) between two sets of patches (GPU vs CPU reference).
 pub fn max_abs_diff(a: &[Vec<RiverTexel>], b: &[Vec<RiverTexel>]) -> f32 {
     a.iter()
         .flatten()
         .zip(b.iter().flatten())
         .map(|(x, y)| {
-            [
-                (x.terrain_height - y.terrain_height).abs(),
-                (x.lerp_factor - y.lerp_factor).abs(),
-                (x.water_height - y.water_height).abs(),
-                (x.min_distance - y.min_distance).abs(),
-                (x.river_width - y.river_width).abs(),
-                (x.flow[0] - y.flow[0]).abs(),
-                (x.flow[1] - y.flow[1]).abs(),
-            ]
-            .into_iter()
-            .fold(0.0f32, f32::max)
+            x.outputs()
+                .into_iter()
+                .zip(y.outputs())
+                .map(|(e, g)| (e - g).abs())
+                .fold(0.0f32, f32::max)
         })
         .fold(0.0, f32::max)
 }
