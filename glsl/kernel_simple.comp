@@ -15,7 +15,8 @@ void main() {
         return;
     }
     uvec2 vertex = patchVertex(job, xy);
-    vec2 v = vec2(vertex) * job.spacing;
+    // Precise: the vertex position enters the decisions of accumulateSample, which must not fuse it.
+    precise vec2 v = vec2(vertex) * job.spacing;
     Accumulators acc = initAccumulators();
     for (uint k = 0; k < job.sampleCount; ++k) {
         accumulateSample(acc, v, prepareSample(samples[job.sampleOffset + k]));

@@ -88,7 +88,8 @@ void main() {
         return;
     }
     uvec2 vertex = patchVertex(job, xy);
-    vec2 v = vec2(vertex) * job.spacing;
+    // Precise: the vertex position enters the decisions of accumulateSample, which must not fuse it.
+    precise vec2 v = vec2(vertex) * job.spacing;
     uint words = wordsOf(job);
 
     // The patch's mask words are read in chunks of TILE_WORDS (invocation i holds word i of the chunk); the

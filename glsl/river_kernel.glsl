@@ -83,13 +83,15 @@ struct Accumulators {
     float inRiverSum;
     float inRiverWSum;
     float minDistance;
+    // Its square: the nearest sample is chosen on it.
+    float minDistance2;
     // Beyond the thesis: the unit directions (downstream) of the samples whose river covers the vertex, weighted
     // as their river depth (the water's flow).
     vec2 flowSum;
 };
 
 Accumulators initAccumulators() {
-    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, vec2(0.0));
+    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38, vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -110,42 +112,58 @@ PreparedSample prepareSample(RiverSample s) {
     return PreparedSample(s.positionDerivative, s.heightWidth.x, halfWidth, 1.0 / (halfWidth * speed));
 }
 
-// Procedure 3 for one sample, accumulated as in Procedure 4.
+// Procedure 3 for one sample, accumulated as in Procedure 4: the CPU reference's quantities
+// (src/kernel/cpu.rs), operation for operation.
 //
-// The same quantities as the CPU reference, computed with one square root instead of three and no division
-// (docs/kernel.md): with r = v - p, the projection distance |vn - v| is |r.d| / |d| and the normal distance
-// |p - vn| is |d x r| / |d|, and d x r is the side of the line Procedure 3 takes the sign from. For a zero
-// derivative the normal line degenerates to p, so the projection distance is the distance to p.
+// Decisions every device takes alike (docs/kernel.md): whether the sample is relevant, whether its basin holds the
+// vertex, which side of its line the vertex lies on and which sample is nearest are decided on squared distances,
+// dot and cross products. Vulkan rounds additions and multiplications correctly, and `precise` forbids fusing them
+// (a driver that contracted d.x * r.y - d.y * r.x into one FMA flipped the sign of the distance of vertices on a
+// sample's line: 39.6 = 2 x 19.8 on NVIDIA), so these equal the CPU's bit for bit. The weights are written to be
+// positive whenever the decision says so; only they carry the rounding of square roots and divisions.
 //
 // On SIMD hardware the body runs under a mask for the whole subgroup when any lane is in reach; lavapipe runs it
 // under a mask always, which is why the tiled kernel stages only the samples within reach of its vertex block.
 void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
     vec2 p = s.positionDerivative.xy;
     vec2 d = s.positionDerivative.zw;
-    vec2 r = v - p;
-    float dist = length(r);
-    if (dist <= params.influenceDistance) {
-        float along = d == vec2(0.0) ? dist : abs(r.x * d.x + r.y * d.y);
-        float side = d.x * r.y - d.y * r.x;
-        float wDist = 1.0 - dist * (1.0 / params.influenceDistance);
+    precise vec2 r = v - p;
+    precise float dist2 = r.x * r.x + r.y * r.y;
+    float reach = params.influenceDistance;
+    precise float reach2 = reach * reach;
+    if (dist2 < reach2) {
+        float dist = sqrt(dist2);
+        // 1 - dist / reach, positive for every relevant sample.
+        float wDist = (reach2 - dist2) / (reach * (reach + dist));
         float basinDepth = wDist * params.basinDepth;
         acc.heightSum += wDist * s.height;
         acc.weightSum += wDist;
         acc.basinSum += basinDepth;
         acc.widthSum += wDist * s.halfWidth;
-        // projectionDistance < halfWidth and normalDistance <= halfWidth, as fractions of the half width.
-        float wRiver = 1.0 - along * s.inverseScale;
-        float normalFactor = abs(side) * s.inverseScale;
-        if (wRiver > 0.0 && normalFactor <= 1.0) {
+        bool zero = d == vec2(0.0);
+        precise float dot_ = r.x * d.x + r.y * d.y;
+        precise float along2 = zero ? dist2 : dot_ * dot_;
+        float along = zero ? dist : abs(dot_);
+        precise float halfWidth2 = s.halfWidth * s.halfWidth;
+        precise float limit2 = zero ? halfWidth2 : halfWidth2 * (d.x * d.x + d.y * d.y);
+        precise float side = d.x * r.y - d.y * r.x;
+        precise float side2 = side * side;
+        // projection distance < half width and normal distance <= half width.
+        if (along2 < limit2 && side2 <= limit2) {
+            float normalFactor = abs(side) * s.inverseScale;
             float factor = normalFactor * normalFactor * normalFactor;
+            // 1 - along / limit, positive in the basin.
+            float wRiver = (limit2 - along2) * (s.inverseScale * s.inverseScale) / (1.0 + along * s.inverseScale);
             acc.inRiver = true;
             acc.inRiverSum += wRiver * factor * basinDepth;
             acc.inRiverWSum += wRiver;
             // d / |d| without another square root: inverseScale x halfWidth = 1 / |d| (and d = 0 stays 0).
             acc.flowSum += wRiver * (d * (s.inverseScale * s.halfWidth));
         }
-        float signedDist = side > 0.0 ? -dist : dist;
-        if (abs(signedDist) < abs(acc.minDistance)) acc.minDistance = signedDist;
+        if (dist2 < acc.minDistance2) {
+            acc.minDistance2 = dist2;
+            acc.minDistance = side > 0.0 ? -dist : dist;
+        }
     }
 }
 

@@ -176,6 +176,121 @@ fn rayon_equals_single_threaded() {
     );
 }
 
+/// Procedure 3 as printed (Section 6.5): the vertex projected onto the sample's normal line, three square roots
+/// and the divisions. Returns (height, w_dist, in basin, w_river, normal factor, signed distance).
+fn procedure_3_as_printed(v: [f32; 2], s: &RiverSample, p: &KernelParams) -> Option<[f32; 6]> {
+    let length = |x: f32, y: f32| (x * x + y * y).sqrt();
+    let (q, d) = (s.position, s.derivative);
+    let dist = length(v[0] - q[0], v[1] - q[1]);
+    if dist > p.influence_distance {
+        return None;
+    }
+    let half_width = s.width * 0.5;
+    let n = [d[1], -d[0]];
+    let nn = n[0] * n[0] + n[1] * n[1];
+    let t = if nn > 0.0 {
+        ((v[0] - q[0]) * n[0] + (v[1] - q[1]) * n[1]) / nn
+    } else {
+        0.0
+    };
+    let vn = [q[0] + t * n[0], q[1] + t * n[1]];
+    let projection = length(vn[0] - v[0], vn[1] - v[1]);
+    let normal = length(q[0] - vn[0], q[1] - vn[1]);
+    let w_dist = 1.0 - dist / p.influence_distance;
+    let in_basin = projection < half_width && normal <= half_width;
+    let side = d[0] * (v[1] - q[1]) - d[1] * (v[0] - q[0]);
+    Some([
+        w_dist * s.height,
+        w_dist,
+        in_basin as u8 as f32,
+        if in_basin {
+            1.0 - projection / half_width
+        } else {
+            0.0
+        },
+        if in_basin { normal / half_width } else { 0.0 },
+        if side > 0.0 { -dist } else { dist },
+    ])
+}
+
+/// The reference rearranges Procedure 3 so that every device decides alike (docs/kernel.md); away from the
+/// decisions' borders, where rounding may go either way, it equals the procedure as printed.
+#[test]
+fn the_reference_equals_procedure_3_as_printed() {
+    let p = params();
+    let mut rng = riverplanet::rng::Rng::new(5, &[]);
+    let mut compared = 0;
+    for _ in 0..20_000 {
+        let mut f = |lo: f32, hi: f32| rng.range(lo, hi);
+        let s = RiverSample::new(
+            [f(0.0, 32.0), f(0.0, 32.0)],
+            [f(-3.0, 3.0), f(-3.0, 3.0)],
+            f(0.0, 9.0),
+            f(0.5, 12.0),
+        );
+        let v = [f(0.0, 32.0), f(0.0, 32.0)];
+        let printed = procedure_3_as_printed(v, &s, &p);
+        let ours = cpu::calculate_height_by_sample(v, &s, &p);
+        let (Some(printed), Some(c)) = (printed, ours) else {
+            assert_eq!(printed.is_some(), ours.is_some(), "{v:?} {s:?}");
+            continue;
+        };
+        // Skip pairs within rounding of a border: the basin's end and side.
+        if printed[2] == 1.0 && (printed[3] < 1e-3 || printed[4] > 1.0 - 1e-3) {
+            continue;
+        }
+        let normal_factor = if c.in_river {
+            (c.in_river_depth / (c.w_river * c.basin_depth)).cbrt()
+        } else {
+            0.0
+        };
+        let ours = [
+            c.height,
+            c.w_dist,
+            c.in_river as u8 as f32,
+            c.w_river,
+            normal_factor,
+            c.dist,
+        ];
+        for (k, (a, b)) in printed.iter().zip(ours).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-4 * a.abs().max(1.0),
+                "{k}: {printed:?} {ours:?} at {v:?} {s:?}"
+            );
+        }
+        compared += 1;
+    }
+    assert!(compared > 5_000, "{compared}");
+}
+
+/// Vulkan rounds additions and multiplications correctly but lets a driver fuse them unless told not to: the
+/// kernels' decisions are `precise` (NoContraction in the SPIR-V), so they equal the CPU's on every device.
+#[test]
+fn kernel_decisions_are_never_fused() {
+    for (name, spirv) in [
+        ("simple", riverplanet::shaders::KERNEL_SIMPLE_COMP),
+        ("tiled", riverplanet::shaders::KERNEL_TILED_COMP),
+    ] {
+        let words: Vec<u32> = spirv
+            .chunks_exact(4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+            .collect();
+        let (mut at, mut no_contraction) = (5, 0);
+        while at < words.len() {
+            let (opcode, length) = (words[at] & 0xffff, (words[at] >> 16) as usize);
+            // OpDecorate (71) with NoContraction (42).
+            if opcode == 71 && words[at + 2] == 42 {
+                no_contraction += 1;
+            }
+            at += length.max(1);
+        }
+        assert!(
+            no_contraction >= 10,
+            "{name}: {no_contraction} NoContraction decorations"
+        );
+    }
+}
+
 #[test]
 fn gpu_kernels_equal_the_cpu_reference() {
     let Some(ctx) = common::gpu() else { return };
@@ -200,6 +315,22 @@ fn gpu_kernels_equal_the_cpu_reference() {
     patches.push((
         0.5,
         vec![RiverSample::new([900.0, 900.0], [1.0, 1.0], 2.0, 2.0)],
+    ));
+    // The case of the mismatch on NVIDIA: vertices on a sample's line (45 degrees), where the side is exactly 0
+    // unless a driver fuses d.x * r.y - d.y * r.x into one FMA, which leaves the rounding error of one product
+    // and flipped the sign of min_distance (2 x the distance).
+    patches.push((
+        1.0,
+        vec![RiverSample::new([2.0, 2.0], [0.7, 0.7], 2.0, 2.0)],
+    ));
+    // Vertices exactly at the influence distance ((24, 4) and (16, 20) from (4, 4)), and one exactly on the
+    // basin's side (8, 10): normal distance = half width.
+    patches.push((
+        1.0,
+        vec![
+            RiverSample::new([4.0, 4.0], [1.0, 0.0], 2.0, 2.0),
+            RiverSample::new([8.0, 8.0], [1.0, 0.0], 3.0, 4.0),
+        ],
     ));
     let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     let reference = cpu::compute_patches(&jobs, N, &p);
@@ -232,14 +363,73 @@ fn gpu_kernels_equal_the_cpu_reference() {
             assert!(gpu.timings[0].ms > 0.0);
             outputs.push(gpu.texels);
         }
-        // Same kernel body, same summation order: the tiled kernel equals the simple one bit for bit.
-        assert_eq!(
-            outputs[0], outputs[1],
-            "{tuning:?}: simple and tiled differ"
+        // Same kernel body, same summation order: the tiled kernel equals the simple one bit for bit on lavapipe;
+        // another driver may compile the two shaders' unmarked arithmetic differently (on NVIDIA both came within
+        // 4e-6 of the reference).
+        let between = max_abs_diff(&outputs[0], &outputs[1]);
+        assert!(
+            between <= tolerance,
+            "{tuning:?}: simple and tiled differ by {between}"
         );
         kernel.destroy(ctx);
     }
     ctx.wait_idle().unwrap();
     bindless.destroy(ctx);
+    common::assert_no_validation_errors(ctx);
+}
+
+/// The kernel's shape is measured on the device at first use, kept in the cache file, read back from it, and
+/// remeasured when the file is not a cache.
+#[test]
+fn kernel_tuning_is_measured_once_and_cached_per_device() {
+    use riverplanet::kernel::gpu::autotune::{cached, device_key, Tuned};
+    let Some(ctx) = common::gpu() else { return };
+    let dir = std::env::temp_dir().join(format!("riverplanet-tuning-{}", std::process::id()));
+    let path = dir.join("nested").join("kernel-tuning.json");
+    let measured = cached(ctx, N, Some(&path)).unwrap();
+    measured.tuning.validate(ctx).unwrap();
+    assert!(
+        measured.simple_ms > 0.0 && measured.tiled_ms > 0.0,
+        "{measured:?}"
+    );
+    let ms = |t: &Tuned| match t.variant {
+        KernelVariant::Simple => t.simple_ms,
+        KernelVariant::Tiled => t.tiled_ms,
+    };
+    assert_eq!(
+        ms(&measured),
+        measured.simple_ms.min(measured.tiled_ms),
+        "the faster variant is chosen"
+    );
+    // The file holds this device's entry; an edited entry is what the next start uses.
+    let read = |p: &std::path::Path| -> std::collections::BTreeMap<String, Tuned> {
+        serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap()
+    };
+    let key = device_key(ctx, N);
+    let mut cache = read(&path);
+    assert_eq!(cache.get(&key), Some(&measured));
+    let edited = Tuned {
+        simple_ms: 123.0,
+        ..measured
+    };
+    cache.insert(key.clone(), edited);
+    std::fs::write(&path, serde_json::to_vec(&cache).unwrap()).unwrap();
+    assert_eq!(cached(ctx, N, Some(&path)).unwrap(), edited);
+    // An entry this device cannot run is measured again.
+    let mut broken = edited;
+    broken.tuning.tiled_block = [3, 3];
+    cache.insert(key.clone(), broken);
+    std::fs::write(&path, serde_json::to_vec(&cache).unwrap()).unwrap();
+    cached(ctx, N, Some(&path))
+        .unwrap()
+        .tuning
+        .validate(ctx)
+        .unwrap();
+    // A file that is not a cache is replaced by a fresh measurement.
+    std::fs::write(&path, b"{ not json").unwrap();
+    let again = cached(ctx, N, Some(&path)).unwrap();
+    again.tuning.validate(ctx).unwrap();
+    assert!(read(&path).contains_key(&key));
+    std::fs::remove_dir_all(&dir).unwrap();
     common::assert_no_validation_errors(ctx);
 }

@@ -15,7 +15,7 @@ use super::{
 use crate::{
     config::Config,
     gpu::{Access, Context, GpuError},
-    kernel::{gpu::KernelTuning, KernelParams, PatchJob, RiverSample},
+    kernel::{gpu::autotune, KernelParams, PatchJob, RiverSample},
     render::{
         target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
         FrameStats, GpuTimes, Renderer, WaterMode,
@@ -458,7 +458,7 @@ pub fn flight_bench(
             ctx,
             config.rendering.new_patches_per_frame as usize + 8,
             n,
-            KernelTuning::for_device(ctx),
+            autotune::tuned(ctx, n)?.tuning,
         )?)
     } else {
         None

@@ -148,10 +148,10 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
          - **Workloads.** Ours are every river patch the scripted flight meets, computed as one batch; the thesis \
          averaged its per-frame work. Per-frame averages are in the flight sections below. Our CPU reference is \
          faster than the thesis's in absolute terms (a newer CPU; the thesis gives no sample counts), so compare ratios.\n\
-         - **Equal output.** The GPU kernels compute Procedure 3 with one square root per pair instead of three and \
-         no division (the same quantities, rearranged); they differ from the CPU reference by at most {:.1e} of the \
-         height range (stress: {:.1e}), and the simple and tiled kernels equal each other bit for bit (tested). The \
-         thesis reported no comparison.\n\
+         - **Equal output.** The GPU kernels compute Procedure 3 with one square root per pair instead of three, \
+         and take its decisions on squares and products that every device rounds alike (docs/kernel.md); they \
+         differ from the CPU reference by at most {:.1e} of the height range (stress: {:.1e}), and on lavapipe the \
+         simple and tiled kernels equal each other bit for bit (tested). The thesis reported no comparison.\n\
          - **Frame rate.** On lavapipe its two rasterizer threads (fragment shading, and the partly covered 4x4 \
          blocks of small triangles shaded whole) bound the frame rate (docs/rendering.md); the frame times below \
          are lavapipe's, not a GPU's.\n",
@@ -321,6 +321,11 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
     if !inputs.frame_flights.is_empty() {
         frame_section(w, inputs.frame_flights)?;
     }
+    let _ = writeln!(
+        w,
+        "## On real GPUs\n\nThe numbers above are lavapipe's. Runs on real GPUs, each with its device, driver and \
+         commands: [results-gpu.md](results-gpu.md).\n"
+    );
     let _ = writeln!(
         w,
         "## How these numbers were made\n\n```sh\n{}\n```",

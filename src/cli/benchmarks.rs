@@ -3,7 +3,7 @@
 use riverplanet::{
     bench,
     gpu::{Context, ContextOptions},
-    kernel::gpu::KernelTuning,
+    kernel::gpu::{autotune, KernelTuning},
 };
 
 use super::BenchCommand;
@@ -28,10 +28,11 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             }
             let world = riverplanet::world::World::build(&config, planet.seed)?;
             let ctx = Context::new(options)?;
+            let tuned = autotune::tuned(&ctx, config.rendering.vertices)?.tuning;
             let tuning = KernelTuning {
-                simple_workgroup,
-                tiled_block: tiled_block.unwrap_or(KernelTuning::default().tiled_block),
-                tile_size,
+                simple_workgroup: simple_workgroup.unwrap_or(tuned.simple_workgroup),
+                tiled_block: tiled_block.unwrap_or(tuned.tiled_block),
+                tile_size: tile_size.unwrap_or(tuned.tile_size),
             };
             if parent_reuse {
                 let report = bench::reuse::reuse_bench(&ctx, &world, frames, repetitions, tuning)?;

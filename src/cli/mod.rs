@@ -12,7 +12,7 @@ use clap::{Parser, Subcommand};
 use riverplanet::{
     config::LodRule,
     export::raster::RasterFormat,
-    kernel::gpu::KernelTuning,
+    kernel::gpu::autotune::KernelChoice,
     named::Named,
     render::{ViewMode, WaterMode},
 };
@@ -147,8 +147,10 @@ pub struct RenderArgs {
     pub water: WaterMode,
     #[arg(long, value_parser = named::<ViewMode>(), default_value = "shaded")]
     pub view: ViewMode,
-    #[arg(long, value_parser = named::<riverplanet::kernel::gpu::KernelVariant>(), default_value = "tiled")]
-    pub kernel: riverplanet::kernel::gpu::KernelVariant,
+    /// The river kernel: `simple` (7.3.1), `tiled` (7.3.2) or `auto`, the faster on this device (measured at
+    /// first use and cached, with the tiled kernel's shape: docs/kernel.md).
+    #[arg(long, value_parser = named::<KernelChoice>(), default_value = "auto")]
+    pub kernel: KernelChoice,
     /// The thesis's level of detail: Eq. 6.1 on patch centres and instant switching, instead of nearest-point
     /// selection with morphing.
     #[arg(long)]
@@ -384,15 +386,15 @@ pub enum BenchCommand {
         /// Repetitions per variant (the median is reported).
         #[arg(long, default_value_t = 5, value_parser = positive_count)]
         repetitions: usize,
-        /// Invocations per workgroup of the simple kernel.
-        #[arg(long, default_value_t = KernelTuning::default().simple_workgroup)]
-        simple_workgroup: u32,
-        /// Vertex block per workgroup of the tiled kernel, as WxH [default: 8x4, KernelTuning::default()].
+        /// Invocations per workgroup of the simple kernel [default: the measured choice of this device].
+        #[arg(long)]
+        simple_workgroup: Option<u32>,
+        /// Vertex block per workgroup of the tiled kernel, as WxH [default: the measured choice of this device].
         #[arg(long, value_parser = parse_block)]
         tiled_block: Option<[u32; 2]>,
-        /// Samples staged per tile by the tiled kernel.
-        #[arg(long, default_value_t = KernelTuning::default().tile_size)]
-        tile_size: u32,
+        /// Samples staged per tile by the tiled kernel [default: the measured choice of this device].
+        #[arg(long)]
+        tile_size: Option<u32>,
         /// Write the report here as JSON.
         #[arg(long)]
         json: Option<PathBuf>,

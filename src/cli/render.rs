@@ -1,6 +1,9 @@
 //! `riverplanet render` (headless) and `riverplanet view` (the interactive viewer).
 
-use riverplanet::gpu::{Context, ContextOptions};
+use riverplanet::{
+    gpu::{Context, ContextOptions},
+    kernel::gpu::autotune::KernelChoice,
+};
 
 use super::{RenderArgs, ViewArgs};
 use crate::{check_output, load_config, planet_seed, usage};
@@ -64,7 +67,9 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     )?;
     renderer.water_mode = args.water;
     renderer.view_mode = args.view;
-    renderer.variant = args.kernel;
+    if let KernelChoice::Fixed(variant) = args.kernel {
+        renderer.variant = variant;
+    }
     renderer.morphing = !args.no_morphing;
     renderer.atmosphere_on = args.atmosphere.on();
     renderer.flowing_water = args.flowing_water.on();

@@ -188,6 +188,9 @@ pub struct SubgroupProperties {
     pub supported_operations: vk::SubgroupFeatureFlags,
     pub required_size_stages: vk::ShaderStageFlags,
     pub max_size: u32,
+    /// Subgroups a compute workgroup may hold: with a required subgroup size, workgroups are limited to this many
+    /// subgroups of that size.
+    pub max_workgroup_subgroups: u32,
 }
 
 /// Queries the subgroup properties of `physical`.
@@ -207,5 +210,6 @@ pub fn subgroup_properties(
         supported_operations: v11.subgroup_supported_operations,
         required_size_stages: v13.required_subgroup_size_stages,
         max_size: v13.max_subgroup_size,
+        max_workgroup_subgroups: v13.max_compute_workgroup_subgroups,
     }
 }

@@ -25,15 +25,21 @@ pub struct SampleContribution {
     pub w_river: f32,
     /// Distance to the sample, negated when the vertex lies left of the sample's direction.
     pub dist: f32,
+    /// The squared distance: the nearest sample is chosen on it, exactly alike on every device.
+    pub dist2: f32,
     /// Beyond the thesis: the sample's unit direction (downstream) times `w_river`, for the water's flow.
     pub flow: [f32; 2],
 }
 
-fn length(x: f32, y: f32) -> f32 {
-    (x * x + y * y).sqrt()
-}
-
 /// Procedure 3, Section 6.5: one vertex against one sample; `None` when the sample is not relevant.
+///
+/// The quantities are the procedure's, rearranged so that every conforming device takes the same decisions
+/// (docs/kernel.md, "Decisions every device takes alike"): whether the sample is relevant, whether its basin holds
+/// the vertex and which side of its line the vertex lies on are decided on squared distances, dot and cross
+/// products, made of additions and multiplications that Vulkan rounds correctly (the kernel body marks them
+/// `precise`, so no driver fuses them), and the weights are written so that they are positive whenever the
+/// decision says so. With r = v - p and d the derivative: projection distance |r.d| / |d|, normal distance
+/// |d x r| / |d|, side d x r.
 pub fn calculate_height_by_sample(
     v: [f32; 2],
     sample: &RiverSample,
@@ -41,23 +47,34 @@ pub fn calculate_height_by_sample(
 ) -> Option<SampleContribution> {
     let p = sample.position;
     let d = sample.derivative;
-    let dist = length(v[0] - p[0], v[1] - p[1]);
-    if dist > params.influence_distance {
+    let r = [v[0] - p[0], v[1] - p[1]];
+    let dist2 = r[0] * r[0] + r[1] * r[1];
+    let reach = params.influence_distance;
+    // Strict: a sample at exactly the influence distance has weight 0 and changes nothing but the sentinels.
+    if dist2 >= reach * reach {
         return None;
     }
+    let dist = dist2.sqrt();
+    // 1 - dist / reach, as (reach^2 - dist^2) / (reach (reach + dist)): positive for every relevant sample.
+    let w_dist = (reach * reach - dist2) / (reach * (reach + dist));
     let half_width = sample.width * 0.5;
-    // n(t) = (p'.y, -p'.x); v projected onto the line through p along n.
-    let n = [d[1], -d[0]];
-    let nn = n[0] * n[0] + n[1] * n[1];
-    let s = if nn > 0.0 {
-        ((v[0] - p[0]) * n[0] + (v[1] - p[1]) * n[1]) / nn
+    let dd = d[0] * d[0] + d[1] * d[1];
+    let zero = d == [0.0, 0.0];
+    // Distance along the flow, unnormalised (|r.d|; the distance to p for a zero derivative, whose normal line
+    // degenerates to p), its square and the square of its limit, the half width (times |d|).
+    let dot = r[0] * d[0] + r[1] * d[1];
+    let (along, along2) = if zero {
+        (dist, dist2)
     } else {
-        0.0
+        (dot.abs(), dot * dot)
     };
-    let vn = [p[0] + s * n[0], p[1] + s * n[1]];
-    let projection_distance = length(vn[0] - v[0], vn[1] - v[1]);
-    let normal_distance = length(p[0] - vn[0], p[1] - vn[1]);
-    let w_dist = 1.0 - dist / params.influence_distance;
+    let limit2 = if zero {
+        half_width * half_width
+    } else {
+        half_width * half_width * dd
+    };
+    // Side of the line p -> p + p' (2D cross product); left of the flow direction is negative.
+    let side = d[0] * r[1] - d[1] * r[0];
     let mut c = SampleContribution {
         height: w_dist * sample.height,
         w_dist,
@@ -66,28 +83,24 @@ pub fn calculate_height_by_sample(
         in_river: false,
         in_river_depth: 0.0,
         w_river: 0.0,
-        dist,
+        dist: if side > 0.0 { -dist } else { dist },
+        dist2,
         flow: [0.0; 2],
     };
-    if projection_distance < half_width && normal_distance <= half_width {
-        let normal_factor = normal_distance / half_width;
+    // projection distance < half width and normal distance <= half width.
+    if along2 < limit2 && side * side <= limit2 {
+        // 1 / (half width x |d|): the fractions of the half width along and across the flow.
+        let inverse_scale = 1.0 / (half_width * if zero { 1.0 } else { dd.sqrt() });
+        let normal_factor = side.abs() * inverse_scale;
         let factor = normal_factor * normal_factor * normal_factor;
         c.in_river = true;
-        c.w_river = 1.0 - projection_distance / half_width;
+        // 1 - along / limit, as (limit^2 - along^2) / (limit (limit + along)): positive in the basin.
+        c.w_river =
+            (limit2 - along2) * (inverse_scale * inverse_scale) / (1.0 + along * inverse_scale);
         c.in_river_depth = c.w_river * factor * c.basin_depth;
-        // 1 / |p'| as the GPU kernel computes it, through 1 / (half width x |p'|); a zero p' gives a zero flow.
-        let speed = if d == [0.0, 0.0] {
-            1.0
-        } else {
-            length(d[0], d[1])
-        };
-        let unit = (1.0 / (half_width * speed)) * half_width;
+        // 1 / |p'| as (1 / (half width x |p'|)) x half width; a zero p' gives a zero flow.
+        let unit = inverse_scale * half_width;
         c.flow = [c.w_river * (d[0] * unit), c.w_river * (d[1] * unit)];
-    }
-    // Side of the line p -> p + p' (2D cross product); left of the flow direction is negative.
-    let side = d[0] * (v[1] - p[1]) - d[1] * (v[0] - p[0]);
-    if side > 0.0 {
-        c.dist = -dist;
     }
     Some(c)
 }
@@ -103,6 +116,8 @@ pub struct Accumulators {
     pub in_river_sum: f32,
     pub in_river_w_sum: f32,
     pub min_distance: f32,
+    /// The square of `min_distance`.
+    pub min_distance2: f32,
     pub flow_sum: [f32; 2],
 }
 
@@ -121,6 +136,7 @@ pub fn accumulate_height(
         in_river_sum: 0.0,
         in_river_w_sum: 0.0,
         min_distance: f32::MAX,
+        min_distance2: f32::MAX,
         flow_sum: [0.0; 2],
     };
     for sample in samples {
@@ -138,7 +154,8 @@ pub fn accumulate_height(
             acc.flow_sum[0] += c.flow[0];
             acc.flow_sum[1] += c.flow[1];
         }
-        if c.dist.abs() < acc.min_distance.abs() {
+        if c.dist2 < acc.min_distance2 {
+            acc.min_distance2 = c.dist2;
             acc.min_distance = c.dist;
         }
     }

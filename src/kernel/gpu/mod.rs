@@ -3,6 +3,7 @@
 //! patch that takes river data from its parent) maps the workgroups' row index to the sample range, the output
 //! slot and the vertices of the row.
 
+pub mod autotune;
 mod batch;
 mod jobs;
 mod tuning;
@@ -25,7 +26,7 @@ use crate::{
 };
 
 /// Which compute shader runs the kernel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum KernelVariant {
     /// One invocation per vertex, samples read from the storage buffer (7.3.1).
     Simple,

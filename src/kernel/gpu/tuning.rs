@@ -4,7 +4,7 @@
 use crate::gpu::Context;
 
 /// Workgroup shapes and tile size, chosen by measurement (docs/kernel.md).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct KernelTuning {
     /// Invocations per workgroup of the simple kernel (1D over a patch's vertices).
     pub simple_workgroup: u32,
@@ -26,10 +26,21 @@ impl Default for KernelTuning {
 }
 
 impl KernelTuning {
-    /// The default, with the block grown until it holds whole subgroups of the device's largest size, and the
-    /// tile shrunk to what the device's shared memory holds.
+    /// The default fitted to the device ([`Self::fitted`]); the renderer uses the measured choice
+    /// ([`super::autotune::tuned`]).
     pub fn for_device(ctx: &Context) -> Self {
-        let mut t = Self::default();
+        let d = Self::default();
+        Self::fitted(ctx, d.tiled_block, d.tile_size)
+    }
+
+    /// A tiled shape made valid on the device: the block grown until it holds whole subgroups of the device's
+    /// largest size, the tile shrunk to what the device's shared memory holds.
+    pub fn fitted(ctx: &Context, block: [u32; 2], tile_size: u32) -> Self {
+        let mut t = Self {
+            tiled_block: block,
+            tile_size,
+            ..Self::default()
+        };
         while t.tiled_invocations() < ctx.subgroup.max_size {
             let [x, y] = t.tiled_block;
             t.tiled_block = if x > y { [x, y * 2] } else { [x * 2, y] };
@@ -64,6 +75,9 @@ impl KernelTuning {
                 "tiled block {x}x{y} must be powers of two, square or twice as wide as high (Morton layout)"
             ));
         }
+        // The tiled kernel requires full subgroups of the largest size, which caps its workgroup at that many
+        // subgroups.
+        let limit = limit.min(subgroup.saturating_mul(ctx.subgroup.max_workgroup_subgroups.max(1)));
         if invocations > limit || invocations % subgroup != 0 {
             return Err(format!(
                 "tiled block {x}x{y} has {invocations} invocations; it must be a multiple of the largest \

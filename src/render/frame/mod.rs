@@ -35,7 +35,7 @@ use crate::{
         Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, MemoryLocation, Semaphore,
     },
     kernel::{
-        gpu::{KernelTuning, KernelVariant, RiverKernel},
+        gpu::{autotune, KernelVariant, RiverKernel},
         KernelParams, PatchJob,
     },
     planet::{atmosphere::Atmosphere, Planet},
@@ -187,7 +187,9 @@ impl<'w> Renderer<'w> {
         let mut bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
         // Two slots per patch at most; keep the cache within what the bindless arrays hold.
         let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
-        let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx))?;
+        // The shape and variant measured on this device at first use (cached per device and driver).
+        let tuned = autotune::tuned(ctx, n)?;
+        let kernel = RiverKernel::new(ctx, &bindless, n, tuned.tuning)?;
         let refiner = HeightRefiner::new(ctx, &bindless, n)?;
         let instance_layout = BufferSetLayout::new(
             ctx,
@@ -309,7 +311,7 @@ impl<'w> Renderer<'w> {
             errors: Arc::new(plan::error_field(planet, network, config)),
             lod_rule: config.rendering.level_of_detail_rule,
             generation_ms_per_patch: None,
-            variant: KernelVariant::Tiled,
+            variant: tuned.variant,
             water_mode: WaterMode::Auto,
             view_mode: ViewMode::Shaded,
             wireframe_on: false,
