@@ -47,6 +47,10 @@ pub struct FlightFrame {
     /// Pixels inside the planet's disc showing the clear colour (the descent checks every tenth frame).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hole_pixels: Option<usize>,
+    /// Whether the frame's time is the renderer's alone. Not for a frame at which the benchmark waited for the GPU
+    /// (a kernel comparison, a hole check, the end of the flight): its time holds the frames in flight before it;
+    /// nor for the frames in flight after it, which start with an empty queue and then wait for each other.
+    pub paced: bool,
 }
 
 /// Averages and maxima over a flight.
@@ -56,7 +60,9 @@ pub struct FlightSummary {
     pub frame_ms_mean: f64,
     /// Triangles the terrain pass drew per frame, on average.
     pub triangles_mean: f64,
+    /// Median of the paced frames ([`FlightFrame::paced`]), warm-up included.
     pub frame_ms_median: f64,
+    /// Slowest frame of all, paced or not.
     pub frame_ms_max: f64,
     pub average_fps: f64,
     pub average_visible_patches: f64,
@@ -84,9 +90,12 @@ pub struct FlightSummary {
     /// Largest memory of any frame (patch textures, temporary data, precomputed heights), as `max_memory_bytes`.
     #[serde(default)]
     pub peak_memory_bytes: u64,
-    /// Slowest frame after the first [`WARMUP_FRAMES`] (start-up: pipelines, the first patches).
+    /// Slowest paced frame after the first [`WARMUP_FRAMES`] (start-up: pipelines, the first patches).
     #[serde(default)]
     pub frame_ms_max_after_warmup: f64,
+    /// Frames whose time is the renderer's alone: what the median and the slowest frame after warm-up cover.
+    #[serde(default)]
+    pub paced_frames: usize,
     /// Patches made per frame (base heights refined or cut, river data computed), at most.
     #[serde(default)]
     pub max_generated_patches: usize,
@@ -242,6 +251,9 @@ fn fly(
     let inner = world.planet.radius + world.planet.height_bounds().0 as f64
         - config.river.basin_depth as f64
         - 1.0;
+    // The last frame at which the benchmark waited for the GPU.
+    let mut waited_at: Option<u32> = None;
+    let in_flight = options.frames_in_flight as u32;
     let result = (|| {
         for frame in 0..options.frames {
             let camera = flight.camera(world, frame);
@@ -266,7 +278,9 @@ fn fly(
                 // The benchmark's own work waits for the GPU; the wait for this frame is the frame's.
                 renderer.finish()?;
                 stats.frame_ms = start.elapsed().as_secs_f64() * 1e3;
+                waited_at = Some(frame);
             }
+            let paced = waited_at.is_none_or(|w| frame > w + in_flight + 1);
             let kernels = match (&mut runner, input.is_empty()) {
                 (Some(runner), false) => {
                     let jobs = PatchJob::from_pairs(&input);
@@ -309,6 +323,7 @@ fn fly(
                 },
                 kernels,
                 hole_pixels,
+                paced,
             });
             attribute_gpu_times(&mut frames, renderer.take_gpu_times());
             progress(frame);
@@ -318,6 +333,7 @@ fn fly(
         renderer.finish()?;
         if let Some(last) = frames.last_mut() {
             last.stats.frame_ms += start.elapsed().as_secs_f64() * 1e3;
+            last.paced = false;
         }
         attribute_gpu_times(&mut frames, renderer.take_gpu_times());
         Ok(())
@@ -349,6 +365,17 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
     let stats: Vec<&FrameStats> = frames.iter().map(|f| &f.stats).collect();
     let frame_ms: Vec<f64> = stats.iter().map(|s| s.frame_ms).collect();
     let frame_ms_mean = mean(frame_ms.iter().copied());
+    // The frames whose time is the renderer's alone, and those of them after warm-up.
+    let paced_ms: Vec<f64> = frames
+        .iter()
+        .filter(|f| f.paced)
+        .map(|f| f.stats.frame_ms)
+        .collect();
+    let paced_after_warmup = frames
+        .iter()
+        .skip(WARMUP_FRAMES)
+        .filter(|f| f.paced)
+        .map(|f| f.stats.frame_ms);
     let keys = |f: &dyn Fn(&FrameStats) -> &BTreeMap<String, f64>| {
         let names: std::collections::BTreeSet<&String> =
             stats.iter().flat_map(|s| f(s).keys()).collect();
@@ -399,14 +426,11 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
         frames: frames.len(),
         frame_ms_mean,
         triangles_mean: mean(stats.iter().map(|s| s.terrain_triangles as f64)),
-        frame_ms_median: super::median(&frame_ms),
+        frame_ms_median: super::median(&paced_ms),
         deepest_level: stats.iter().map(|s| s.deepest_level).max().unwrap_or(0),
         peak_memory_bytes: max_memory_bytes,
-        frame_ms_max_after_warmup: frame_ms
-            .iter()
-            .skip(WARMUP_FRAMES)
-            .copied()
-            .fold(0.0, f64::max),
+        frame_ms_max_after_warmup: paced_after_warmup.fold(0.0, f64::max),
+        paced_frames: paced_ms.len(),
         max_generated_patches: stats.iter().map(|s| s.new_patches).max().unwrap_or(0),
         hole_checked_frames: frames.iter().filter(|f| f.hole_pixels.is_some()).count(),
         hole_pixels: frames.iter().filter_map(|f| f.hole_pixels).sum(),
@@ -526,14 +550,14 @@ pub fn to_csv(report: &FlightReport) -> String {
     let mut out = String::from(
         "frame,altitude,visible_patches,new_patches,river_patches,fallback_patches,samples,frame_ms,gpu_kernel_ms,\
          gpu_terrain_ms,gpu_water_ms,memory_bytes,patch_texture_bytes,temporary_sample_bytes,resident_patches,\
-         cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms\n",
+         cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms,paced\n",
     );
     for f in &report.frames {
         let s = &f.stats;
         let g = |k: &str| s.gpu_ms.get(k).copied().unwrap_or(0.0);
         let k = f.kernels.clone().unwrap_or_default();
         out.push_str(&format!(
-            "{},{:.3},{},{},{},{},{},{:.3},{:.4},{:.3},{:.3},{},{},{},{},{:.4},{:.4},{:.4},{:.4}\n",
+            "{},{:.3},{},{},{},{},{},{:.3},{:.4},{:.3},{:.3},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{}\n",
             s.frame,
             f.altitude,
             s.visible_patches,
@@ -552,7 +576,8 @@ pub fn to_csv(report: &FlightReport) -> String {
             k.cpu_single_ms,
             k.cpu_rayon_ms,
             k.gpu_simple_ms,
-            k.gpu_tiled_ms
+            k.gpu_tiled_ms,
+            f.paced as u8
         ));
     }
     out

@@ -287,7 +287,9 @@ pub fn results_markdown(inputs: &ReportInputs) -> Result<String, PlotError> {
             w,
             "## The descent to the ground\n\nBeyond the thesis: `bench flight --descent` from three radii out to 2 world \
              units above the first river's water (60 % of the frames), then turning a quarter round there; every tenth \
-             frame is checked for holes (docs/rendering.md). Frame times include waiting for the GPU.\n\n\
+             frame is checked for holes (docs/rendering.md). Frame times include waiting for the GPU; the median and the \
+             slowest frame after ten cover the paced frames only: not a checked frame, at which the benchmark waits for \
+             the GPU, nor the frames in flight after it, nor the last (docs/rendering.md, \"Frame times\").\n\n\
              | report | river model | level of detail | planet radius | morphing | river data from the parent | frames | deepest level | peak memory | frame ms median | max after 10 frames | max / median | hole pixels (frames checked) |\n\
              |---|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
