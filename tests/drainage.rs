@@ -4,9 +4,11 @@
 use glam::DVec3;
 use riverplanet::{
     drainage::{
+        finer::network_at,
         grid::SphereGrid,
         rivers::{extract, Thresholds},
         routing::{route, NONE},
+        Drainage,
     },
     planet::{cube::FACES, heights::FaceLattice},
 };
@@ -167,21 +169,85 @@ fn assert_natural(config: &riverplanet::config::Config, seed: u32) {
         "seed {seed}: {m:?}"
     );
     assert!(m.drained_land_fraction >= 0.6, "seed {seed}: {m:?}");
-    assert_eq!(m.uphill_steps, 0);
-    assert_eq!(m.crossings, 0);
     assert!(m.confluences > 100 && m.rivers > 10);
-    // Beds never rise downstream, within a reach or into the next.
+    assert_flows_downhill_and_never_crosses(d, &format!("seed {seed}"));
+}
+
+/// The model's guarantees: no bed rising downstream, within a reach or into the next, and no two courses (as
+/// drawn: meandering where the relief is eroded) crossing.
+fn assert_flows_downhill_and_never_crosses(d: &Drainage, what: &str) {
+    let m = &d.measures;
+    assert_eq!(m.uphill_steps, 0, "{what}");
+    assert_eq!(m.crossings, 0, "{what}");
     for reach in &d.reaches {
-        assert!(reach.beds.windows(2).all(|w| w[1] <= w[0]));
+        assert!(reach.beds.windows(2).all(|w| w[1] <= w[0]), "{what}");
         if let Some(next) = reach.downstream {
-            assert!(d.reaches[next].beds[0] <= *reach.beds.last().unwrap());
+            assert!(
+                d.reaches[next].beds[0] <= *reach.beds.last().unwrap(),
+                "{what}"
+            );
         }
     }
-    // The courses as drawn (meandering where the relief is eroded) cross nowhere.
     let crossing = riverplanet::drainage::meanders::crossing_reaches(&d.reaches);
+    assert!(crossing.is_empty(), "{what}: reaches {crossing:?} cross");
+}
+
+/// Rivers at every scale: the network routed again two levels finer has at least twice the reaches (each level
+/// adds the streams its resolution holds) and a higher Strahler order, keeps the guarantees, and refines the base
+/// network rather than replacing it: its rivers run where the base rivers run.
+#[test]
+fn finer_levels_add_streams_that_join_the_base_network() {
+    let config = drainage_config();
+    let planet = riverplanet::planet::Planet::generate(&config, 1, |_| {}).unwrap();
+    let base = planet.drainage.as_ref().unwrap();
+    let level = planet.stats.base_level + 2;
+    let finer = network_at(&planet, &config, level).unwrap();
+    let (b, f) = (&base.measures, &finer.measures);
+    println!("base: {b:?}\nlevel {level}: {f:?}");
     assert!(
-        crossing.is_empty(),
-        "seed {seed}: reaches {crossing:?} cross"
+        f.reaches >= 2 * b.reaches,
+        "{} against {}",
+        f.reaches,
+        b.reaches
+    );
+    assert!(f.strahler_max > b.strahler_max);
+    assert!((3.0..=5.0).contains(&f.bifurcation_ratio), "{f:?}");
+    assert_flows_downhill_and_never_crosses(&finer, &format!("level {level}"));
+    // Every base river point of order 2 and more lies within one base cell of a finer river point (meandering
+    // courses stray a quarter cell from their valley lines): buckets of a base cell on each face.
+    let cells = (config.planet.base_resolution - 1) as f64;
+    let bucket = |p: DVec3| {
+        let (face, u, v) = riverplanet::planet::cube::face_of(p);
+        let at = |x: f64| ((x + 1.0) * 0.5 * cells).floor() as i64;
+        (face, at(u), at(v))
+    };
+    let mut fine: std::collections::HashMap<(usize, i64, i64), Vec<DVec3>> = Default::default();
+    for p in finer.reaches.iter().flat_map(|r| &r.points) {
+        fine.entry(bucket(*p)).or_default().push(*p);
+    }
+    let cell = std::f64::consts::FRAC_PI_2 / cells;
+    let base_points: Vec<DVec3> = base
+        .reaches
+        .iter()
+        .filter(|r| r.strahler >= 2)
+        .flat_map(|r| r.points.iter().copied())
+        .collect();
+    let near = base_points
+        .iter()
+        .filter(|p| {
+            let (face, i, j) = bucket(**p);
+            (-1..=1).any(|di| {
+                (-1..=1).any(|dj| {
+                    fine.get(&(face, i + di, j + dj))
+                        .is_some_and(|q| q.iter().any(|q| q.angle_between(**p) <= cell))
+                })
+            })
+        })
+        .count();
+    let share = near as f64 / base_points.len() as f64;
+    assert!(
+        share >= 0.95,
+        "{share} of the base river points near a finer river"
     );
 }
 

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use riverplanet::{
+    drainage::finer,
     export::{
         self,
         carved::{carved_terrain, MAX_EXPORT_LEVEL},
@@ -202,23 +203,46 @@ fn export_rivers(planet: super::PlanetArgs, level: Option<u32>, out: &Path) -> a
         )));
     }
     let drainage = config.river.model == riverplanet::config::RiverModel::Drainage;
-    if let (Some(level), true) = (level, drainage) {
+    // The drainage network is routed anew at levels above its base lattice's (docs/rivers.md).
+    let max_level = if drainage {
+        // A loaded configuration has a valid base resolution, so its base level exists.
+        config.base_level().unwrap_or(0) + finer::MAX_LEVELS_ABOVE_BASE
+    } else {
+        MAX_RIVER_LEVEL
+    };
+    if let Some(level) = level.filter(|&l| l > max_level) {
         return Err(usage(format!(
-            "--level {level}: {source} uses the drainage river model, whose reaches have one level; \
-             --level refines the thesis's model (river-model thesis)"
-        )));
-    }
-    let level = level.unwrap_or(config.river.hull_levels);
-    if level > MAX_RIVER_LEVEL {
-        return Err(usage(format!(
-            "--level {level} must be in [0, {MAX_RIVER_LEVEL}]"
+            "--level {level} must be in [0, {max_level}] for {source}{}",
+            if drainage {
+                " (the drainage network's base level and two above it)"
+            } else {
+                ""
+            }
         )));
     }
     let seed = planet_seed(planet.seed, &config);
     let world = World::build(&config, seed)?;
-    let geojson = match &world.planet.drainage {
-        Some(drainage) => export::drainage::drainage_geojson(drainage, &config),
-        None => export::rivers_geojson(&world.network, level, world.planet.radius),
+    let geojson = if drainage {
+        let level = level.unwrap_or(world.planet.stats.base_level);
+        let network = finer::network_at(&world.planet, &config, level)
+            .ok_or_else(|| anyhow::anyhow!("{source}: the drainage model made no network"))?;
+        let m = &network.measures;
+        println!(
+            "level {level}: {} reaches, {} confluences, {} lakes, Strahler order {}, bifurcation ratio {:.2}, \
+             Hack exponent {:.3}, {} uphill steps, {} crossings",
+            m.reaches,
+            m.confluences,
+            m.lakes,
+            m.strahler_max,
+            m.bifurcation_ratio,
+            m.hack_exponent,
+            m.uphill_steps,
+            m.crossings
+        );
+        export::drainage::drainage_geojson(&network, &config)
+    } else {
+        let level = level.unwrap_or(config.river.hull_levels);
+        export::rivers_geojson(&world.network, level, world.planet.radius)
     };
     let features = geojson["features"].as_array().map_or(0, Vec::len);
     export::files::write_bytes(out, serde_json::to_string(&geojson)?.as_bytes())?;

@@ -319,8 +319,10 @@ pub enum ExportCommand {
     Rivers {
         #[command(flatten)]
         planet: PlanetArgs,
-        /// The thesis's river model only: how often its pieces are refined, 0 to 8 [default: hull-levels, what
-        /// `generate` counts in stats.json]. The drainage model's reaches have one level.
+        /// The thesis's river model: how often its pieces are refined, 0 to 8 [default: hull-levels, what
+        /// `generate` counts in stats.json]. The drainage model: the patch level whose heights the water is
+        /// routed over, up to two above its base lattice's, each adding the streams that level resolves
+        /// [default: the base lattice's level].
         #[arg(long)]
         level: Option<u32>,
         /// The GeoJSON file (.geojson or .json).
