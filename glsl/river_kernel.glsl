@@ -28,6 +28,8 @@ struct PatchJob {
 };
 
 const uint NO_PARENT = 0xffffffffu;
+// The half width a lake's vertices report (LAKE_HALF_WIDTH in src/kernel/cpu.rs).
+const float LAKE_HALF_WIDTH = 1e9;
 
 // Layer 0: terrain height, lerp factor, water height, signed minimum distance. Layer 1: river half width.
 // Read as well as written: rows that copy from the parent read its texture.
@@ -85,13 +87,16 @@ struct Accumulators {
     float minDistance;
     // Its square: the nearest sample is chosen on it.
     float minDistance2;
+    // Beyond the thesis: the highest level of the lakes whose samples reach the vertex (-FLT_MAX: none).
+    float lakeLevel;
     // Beyond the thesis: the unit directions (downstream) of the samples whose river covers the vertex, weighted
     // as their river depth (the water's flow).
     vec2 flowSum;
 };
 
 Accumulators initAccumulators() {
-    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38, vec2(0.0));
+    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38, -3.402823466e38,
+                        vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -129,6 +134,13 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
     vec2 d = s.positionDerivative.zw;
     precise vec2 r = v - p;
     precise float dist2 = r.x * r.x + r.y * r.y;
+    // A lake's sample (negative width): its level reaches the vertices within half its width, and it takes no
+    // part in Procedure 3.
+    if (s.halfWidth < 0.0) {
+        precise float lakeReach2 = s.halfWidth * s.halfWidth;
+        if (dist2 < lakeReach2) acc.lakeLevel = max(acc.lakeLevel, s.height);
+        return;
+    }
     float reach = params.influenceDistance;
     precise float reach2 = reach * reach;
     if (dist2 < reach2) {
@@ -189,6 +201,14 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
                     heights = vec4(terrainHeight, lerpFactor, max(params.seaLevel, terrainHeight - params.basinWaterOffset),
                         acc.minDistance);
         }
+    }
+    // Beyond the thesis: a vertex a lake reaches, outside every river's basin, gets the lake's level as its
+    // water, a distance of 0 and the lake half width, which the shaders read as a basin whose water the mesh shows
+    // where the terrain lies below it (src/kernel/cpu.rs, with_lake).
+    if (acc.lakeLevel > -3.402823466e38 && !acc.inRiver) {
+        heights.z = acc.lakeLevel;
+        heights.w = 0.0;
+        riverWidth = LAKE_HALF_WIDTH;
     }
     imageStore(riverImages[job.slot], ivec3(xy, 0), heights);
     imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, flow, 0.0));

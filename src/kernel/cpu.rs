@@ -31,7 +31,7 @@ pub struct SampleContribution {
     pub flow: [f32; 2],
 }
 
-/// Procedure 3, Section 6.5: one vertex against one sample; `None` when the sample is not relevant.
+/// Procedure 3, Section 6.5: one vertex against one sample; `None` when the sample is not relevant (or a lake's).
 ///
 /// The quantities are the procedure's, rearranged so that every conforming device takes the same decisions
 /// (docs/kernel.md, "Decisions every device takes alike"): whether the sample is relevant, whether its basin holds
@@ -45,6 +45,9 @@ pub fn calculate_height_by_sample(
     sample: &RiverSample,
     params: &KernelParams,
 ) -> Option<SampleContribution> {
+    if sample.width < 0.0 {
+        return None;
+    }
     let p = sample.position;
     let d = sample.derivative;
     let r = [v[0] - p[0], v[1] - p[1]];
@@ -118,6 +121,9 @@ pub struct Accumulators {
     pub min_distance: f32,
     /// The square of `min_distance`.
     pub min_distance2: f32,
+    /// Beyond the thesis: the highest water level of the lake samples within half their width of the vertex
+    /// (`-f32::MAX` where none is).
+    pub lake_level: f32,
     pub flow_sum: [f32; 2],
 }
 
@@ -137,9 +143,20 @@ pub fn accumulate_height(
         in_river_w_sum: 0.0,
         min_distance: f32::MAX,
         min_distance2: f32::MAX,
+        lake_level: -f32::MAX,
         flow_sum: [0.0; 2],
     };
     for sample in samples {
+        if sample.width < 0.0 {
+            // A lake's sample: its level reaches the vertices within half its width (decided on the exact
+            // squares, as Procedure 3's decisions).
+            let r = [v[0] - sample.position[0], v[1] - sample.position[1]];
+            let half_width = sample.width * 0.5;
+            if r[0] * r[0] + r[1] * r[1] < half_width * half_width {
+                acc.lake_level = acc.lake_level.max(sample.height);
+            }
+            continue;
+        }
         let Some(c) = calculate_height_by_sample(v, sample, params) else {
             continue;
         };
@@ -166,6 +183,31 @@ pub fn accumulate_height(
 /// river (half) width of one vertex.
 pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelParams) -> RiverTexel {
     let acc = accumulate_height(v, samples, params);
+    let texel = river_outputs(&acc, params);
+    with_lake(texel, &acc)
+}
+
+/// Beyond the thesis (docs/kernel.md, "Lakes"): a vertex a lake reaches, outside every river's basin, gets the
+/// lake's level as its water (outside a basin Procedure 5's water lies just below the terrain, hidden), a signed
+/// distance of 0 and a half width of [`LAKE_HALF_WIDTH`], which the shaders
+/// read as "in a basin whose water the mesh shows": the water is drawn where the terrain lies below the level, so
+/// the shore is the terrain's contour. The lerp factor stays as the rivers make it, so the terrain is the
+/// planet's own; a river's basin keeps its river's water (an outlet's falls below the level).
+fn with_lake(mut texel: RiverTexel, acc: &Accumulators) -> RiverTexel {
+    if acc.lake_level > -f32::MAX && !acc.in_river {
+        texel.water_height = acc.lake_level;
+        texel.min_distance = 0.0;
+        texel.river_width = LAKE_HALF_WIDTH;
+    }
+    texel
+}
+
+/// The half width a lake's vertices report: wider than any vertex spacing, so no lake is painted (8.4) and the
+/// mesh always draws its water, as it draws the sea's.
+pub const LAKE_HALF_WIDTH: f32 = 1e9;
+
+/// Procedure 5's outputs from the accumulators.
+fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
     if acc.weight_sum <= 0.0 {
         return RiverTexel {
             terrain_height: 0.0,

@@ -105,6 +105,7 @@ pub fn systems(
                         generation: 0,
                         branch: branch(k),
                         parent_branch: reach.downstream.map(branch),
+                        lake: false,
                     });
                 }
             }
@@ -126,11 +127,11 @@ pub fn systems(
     systems
 }
 
-/// A lake as a river system the kernel draws as water at the lake's level: one short straight piece through each
-/// of its lattice points, a base cell long and one and a half cells wide, so the pieces' basins cover the lake.
-/// The pieces are at the deepest subdivision already (no meanders, no tributaries), and their bed lies the basin
-/// depth minus the water offset below the level, which puts the kernel's water height (bed + basin depth - water
-/// offset, Procedure 5) at the level.
+/// A lake as a river system whose pieces carry its water level: one short straight piece through each of its
+/// lattice points, a base cell long and two wide, so that the vertices within a cell of the lake get the level
+/// (the kernel's lake samples) and the terrain below it is drawn under water there: the shore is the refined
+/// terrain's contour at the level, which lies between the lake's last lattice point and the first one above it. The
+/// pieces are at the deepest subdivision already (no meanders, no tributaries) and carve nothing.
 fn lake_system(
     lake: &LakeShape,
     id: u32,
@@ -142,9 +143,7 @@ fn lake_system(
     let frame = RiverFrame::new(centre, centre.any_orthonormal_vector() + centre, radius);
     // The distance between neighbouring lattice points of the lake: its area over its points.
     let cell = (lake.area / lake.points.len().max(1) as f64).sqrt();
-    let r = &config.river;
-    let bed = lake.level - r.basin_depth + r.basin_water_offset;
-    let width = (1.5 * cell) as f32;
+    let width = (2.0 * cell) as f32;
     let branch = rng::hash(params.seed, &[0x6c61_6b65, id as u64]);
     let half = DVec2::new(0.5 * cell, 0.0);
     let segments = lake
@@ -160,13 +159,14 @@ fn lake_system(
                     p1: at + half,
                     d1: half * 2.0,
                 },
-                heights: (bed, bed),
+                heights: (lake.level, lake.level),
                 widths: (width, width),
                 key: rng::hash(branch, &[k as u64]),
                 depth: MAX_DEPTH,
                 generation: 0,
                 branch,
                 parent_branch: None,
+                lake: true,
             })
         })
         .collect();

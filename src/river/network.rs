@@ -79,6 +79,9 @@ pub struct Segment {
     /// Key of the branch (main river or tributary) this piece belongs to, and of the branch it flows into.
     pub branch: u64,
     pub parent_branch: Option<u64>,
+    /// A lake's piece (beyond the thesis, docs/rivers.md): its height is the lake's water level, and its samples
+    /// put that level on the vertices within half its width, where the terrain below it is drawn under water.
+    pub lake: bool,
 }
 
 impl Segment {
@@ -236,6 +239,7 @@ pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>
             generation: segment.generation + 1,
             branch: key,
             parent_branch: Some(segment.branch),
+            lake: false,
         })
     });
     (children, tributary.flatten())
@@ -465,6 +469,7 @@ fn build_system(
                 generation: 0,
                 branch,
                 parent_branch: None,
+                lake: false,
             }
         })
         .collect();

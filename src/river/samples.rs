@@ -147,7 +147,7 @@ fn emit(
 ) {
     out.extend(
         piece_samples(network, system, frame, piece)
-            .filter(|(p, s)| hull::distance(outline, *p) <= reach + s.width as f64)
+            .filter(|(p, s)| hull::distance(outline, *p) <= reach + s.width.abs() as f64)
             .map(|(_, s)| s),
     );
 }
@@ -199,7 +199,8 @@ pub fn piece_samples<'a>(
             position.as_vec2().to_array(),
             derivative.as_vec2().to_array(),
             piece.height_at(t),
-            (width * stretch) as f32,
+            // A lake's samples say what they are by a negative width (RiverSample).
+            (width * stretch) as f32 * if piece.lake { -1.0 } else { 1.0 },
         );
         t += sample_step(network, width).max(floor) / speed;
         Some((p, sample))
