@@ -15,7 +15,7 @@ use std::{
 
 use serde::{Deserialize, Serialize};
 
-use super::{run_batch, KernelTuning, KernelVariant, RiverKernel};
+use super::{run_batch_into, BatchOutputs, KernelTuning, KernelVariant, RiverKernel};
 use crate::{
     gpu::{bindless::Bindless, Context, GpuError},
     kernel::{workload, KernelParams, PatchJob},
@@ -130,12 +130,23 @@ pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
         .collect();
     let jobs = PatchJob::from_pairs(&patches);
     let mut bindless = Bindless::new(ctx, PATCHES as u32 + 16)?;
-    let mut time = |tuning: KernelTuning, variant| -> Result<f64, GpuError> {
+    // One set of output textures for every run (freed slots return only once the GPU is done with them).
+    let outputs = BatchOutputs::new(ctx, &mut bindless, jobs.len(), grid_size)?;
+    let time = |tuning: KernelTuning, variant| -> Result<f64, GpuError> {
         let kernel = RiverKernel::new(ctx, &bindless, grid_size, tuning)?;
         let mut runs = Vec::new();
         // One warm-up run, then the measured ones.
         for _ in 0..=REPETITIONS {
-            let result = run_batch(ctx, &mut bindless, &kernel, variant, &jobs, &params);
+            let result = run_batch_into(
+                ctx,
+                &bindless,
+                &kernel,
+                variant,
+                &jobs,
+                &[],
+                &params,
+                &outputs,
+            );
             match result {
                 Ok(r) => runs.push(r.timings.iter().map(|t| t.ms).sum::<f64>()),
                 Err(e) => {
@@ -150,20 +161,25 @@ pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
         Ok(runs[runs.len() / 2])
     };
     let base = KernelTuning::for_device(ctx);
-    let simple_ms = time(base, KernelVariant::Simple)?;
-    let mut best: Option<(KernelTuning, f64)> = None;
-    for (block, tile_size) in CANDIDATES {
-        let tuning = KernelTuning::fitted(ctx, block, tile_size);
-        if tuning.validate(ctx).is_err() || best.is_some_and(|(t, _)| t == tuning) {
-            continue;
+    let timed = (|| {
+        let simple_ms = time(base, KernelVariant::Simple)?;
+        let mut best: Option<(KernelTuning, f64)> = None;
+        for (block, tile_size) in CANDIDATES {
+            let tuning = KernelTuning::fitted(ctx, block, tile_size);
+            if tuning.validate(ctx).is_err() || best.is_some_and(|(t, _)| t == tuning) {
+                continue;
+            }
+            let ms = time(tuning, KernelVariant::Tiled)?;
+            if best.is_none_or(|(_, b)| ms < b) {
+                best = Some((tuning, ms));
+            }
         }
-        let ms = time(tuning, KernelVariant::Tiled)?;
-        if best.is_none_or(|(_, b)| ms < b) {
-            best = Some((tuning, ms));
-        }
-    }
+        Ok::<_, GpuError>((simple_ms, best))
+    })();
     ctx.wait_idle()?;
+    outputs.destroy(ctx, &mut bindless);
     bindless.destroy(ctx);
+    let (simple_ms, best) = timed?;
     let (tuning, tiled_ms) = best.unwrap_or((base, f64::INFINITY));
     Ok(Tuned {
         tuning,
