@@ -550,14 +550,17 @@ pub fn to_csv(report: &FlightReport) -> String {
     let mut out = String::from(
         "frame,altitude,visible_patches,new_patches,river_patches,fallback_patches,samples,frame_ms,gpu_kernel_ms,\
          gpu_terrain_ms,gpu_water_ms,memory_bytes,patch_texture_bytes,temporary_sample_bytes,resident_patches,\
-         cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms,paced\n",
+         cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms,paced,cpu_cull_ms,cpu_lod_ms,cpu_samples_ms,\
+         cpu_wait_ms,cpu_upload_ms,cpu_record_ms,cpu_submit_ms\n",
     );
     for f in &report.frames {
         let s = &f.stats;
         let g = |k: &str| s.gpu_ms.get(k).copied().unwrap_or(0.0);
+        let c = |k: &str| s.cpu_ms.get(k).copied().unwrap_or(0.0);
         let k = f.kernels.clone().unwrap_or_default();
         out.push_str(&format!(
-            "{},{:.3},{},{},{},{},{},{:.3},{:.4},{:.3},{:.3},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{}\n",
+            "{},{:.3},{},{},{},{},{},{:.3},{:.4},{:.3},{:.3},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{},{:.3},{:.3},{:.3},\
+             {:.3},{:.3},{:.3},{:.3}\n",
             s.frame,
             f.altitude,
             s.visible_patches,
@@ -577,7 +580,14 @@ pub fn to_csv(report: &FlightReport) -> String {
             k.cpu_rayon_ms,
             k.gpu_simple_ms,
             k.gpu_tiled_ms,
-            f.paced as u8
+            f.paced as u8,
+            c("cull"),
+            c("lod"),
+            c("influence+samples"),
+            c("frame wait"),
+            c("upload"),
+            c("record"),
+            c("submit"),
         ));
     }
     out

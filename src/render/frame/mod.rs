@@ -406,11 +406,15 @@ impl<'w> Renderer<'w> {
         cpu.insert("frame wait".to_string(), ms_since(t));
         self.collect(finished.into_iter().collect())?;
 
+        // The new patches' textures made and their work recorded, apart from the drawing: where a frame that
+        // makes many patches spends its CPU time.
         let t = Instant::now();
         let uploaded = self.upload_new_patches(&mut rec, &prepared)?;
         stats.temporary_sample_bytes = uploaded.bytes;
         stats.river_patches = uploaded.river_patches;
         stats.river_patches_from_parent = uploaded.river_patches_from_parent;
+        cpu.insert("upload".to_string(), ms_since(t));
+        let t = Instant::now();
         let drawn = self.record_draw(
             &mut rec,
             camera,
