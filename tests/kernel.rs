@@ -445,9 +445,22 @@ fn kernel_tuning_is_measured_once_and_cached_per_device() {
     };
     let key = device_key(ctx, N);
     let mut cache = read(&path);
-    assert_eq!(cache.get(&key), Some(&measured));
+    // JSON keeps the choice exactly and the times to their last bit or so (serde_json's parsing).
+    let stored = cache[&key];
+    assert_eq!(
+        (stored.tuning, stored.variant),
+        (measured.tuning, measured.variant)
+    );
+    for (a, b) in [
+        (stored.simple_ms, measured.simple_ms),
+        (stored.tiled_ms, measured.tiled_ms),
+    ] {
+        assert!((a - b).abs() <= 1e-12 * b, "{stored:?} {measured:?}");
+    }
+    // Times that JSON holds exactly, so the entry read back must equal it.
     let edited = Tuned {
         simple_ms: 123.0,
+        tiled_ms: 45.5,
         ..measured
     };
     cache.insert(key.clone(), edited);
