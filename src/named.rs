@@ -25,7 +25,7 @@ mod tests {
     use super::Named;
     use crate::{
         config::{LodRule, RiverModel},
-        kernel::gpu::KernelVariant,
+        kernel::gpu::autotune::KernelChoice,
         render::{presets::Preset, ViewMode, WaterMode},
     };
 
@@ -42,7 +42,7 @@ mod tests {
     fn every_named_value_reads_back() {
         round_trip::<WaterMode>();
         round_trip::<ViewMode>();
-        round_trip::<KernelVariant>();
+        round_trip::<KernelChoice>();
         round_trip::<Preset>();
         round_trip::<LodRule>();
         round_trip::<RiverModel>();

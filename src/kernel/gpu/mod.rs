@@ -301,8 +301,3 @@ pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result
         array: true,
     })
 }
-
-impl crate::named::Named for KernelVariant {
-    const ALL: &'static [(&'static str, Self)] =
-        &[("simple", Self::Simple), ("tiled", Self::Tiled)];
-}
