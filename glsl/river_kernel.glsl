@@ -2,7 +2,8 @@
 // kernel_tiled.comp (7.3.2). Mirrors src/kernel/cpu.rs operation for operation; see docs/kernel.md.
 #extension GL_EXT_nonuniform_qualifier : require
 
-// Position (xy) and first derivative (zw); height (x) and full width (y).
+// Position (xy) and first derivative (zw); height (x), full width (y) and, beyond the thesis, the sample's own
+// influence distance (z; 0: the kernel's, which bounds it).
 struct RiverSample {
     vec4 positionDerivative;
     vec4 heightWidth;
@@ -87,6 +88,10 @@ struct Accumulators {
     float minDistance;
     // Its square: the nearest sample is chosen on it.
     float minDistance2;
+    // The influence distance of the nearest sample: the lerp factor reaches 1 there.
+    float nearestReach;
+    // The half width of the nearest sample.
+    float nearestHalfWidth;
     // Beyond the thesis: the highest level of the lakes whose samples reach the vertex (-FLT_MAX: none).
     float lakeLevel;
     // Beyond the thesis: the unit directions (downstream) of the samples whose river covers the vertex, weighted
@@ -95,8 +100,8 @@ struct Accumulators {
 };
 
 Accumulators initAccumulators() {
-    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38, -3.402823466e38,
-                        vec2(0.0));
+    return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38,
+                        params.influenceDistance, 0.0, -3.402823466e38, vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -105,16 +110,13 @@ struct PreparedSample {
     vec4 positionDerivative;
     float height;
     float halfWidth;
-    // 1 / (halfWidth x |derivative|): turns the unnormalised distances along and across the flow into the
-    // fractions of the half width that Procedure 3 uses. 1 / halfWidth for a zero derivative.
-    float inverseScale;
+    // The sample's influence distance.
+    float reach;
 };
 
 PreparedSample prepareSample(RiverSample s) {
-    vec2 d = s.positionDerivative.zw;
-    float halfWidth = s.heightWidth.y * 0.5;
-    float speed = d == vec2(0.0) ? 1.0 : length(d);
-    return PreparedSample(s.positionDerivative, s.heightWidth.x, halfWidth, 1.0 / (halfWidth * speed));
+    float reach = s.heightWidth.z > 0.0 ? s.heightWidth.z : params.influenceDistance;
+    return PreparedSample(s.positionDerivative, s.heightWidth.x, s.heightWidth.y * 0.5, reach);
 }
 
 // Procedure 3 for one sample, accumulated as in Procedure 4: the CPU reference's quantities
@@ -141,7 +143,7 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
         if (dist2 < lakeReach2) acc.lakeLevel = max(acc.lakeLevel, s.height);
         return;
     }
-    float reach = params.influenceDistance;
+    float reach = s.reach;
     precise float reach2 = reach * reach;
     if (dist2 < reach2) {
         float dist = sqrt(dist2);
@@ -157,24 +159,30 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
         precise float along2 = zero ? dist2 : dot_ * dot_;
         float along = zero ? dist : abs(dot_);
         precise float halfWidth2 = s.halfWidth * s.halfWidth;
-        precise float limit2 = zero ? halfWidth2 : halfWidth2 * (d.x * d.x + d.y * d.y);
+        precise float dd = d.x * d.x + d.y * d.y;
+        precise float limit2 = zero ? halfWidth2 : halfWidth2 * dd;
         precise float side = d.x * r.y - d.y * r.x;
         precise float side2 = side * side;
         // projection distance < half width and normal distance <= half width.
         if (along2 < limit2 && side2 <= limit2) {
-            float normalFactor = abs(side) * s.inverseScale;
+            // 1 / (halfWidth x |derivative|): turns the unnormalised distances along and across the flow into the
+            // fractions of the half width that Procedure 3 uses. 1 / halfWidth for a zero derivative.
+            float inverseScale = 1.0 / (s.halfWidth * (zero ? 1.0 : sqrt(dd)));
+            float normalFactor = abs(side) * inverseScale;
             float factor = normalFactor * normalFactor * normalFactor;
             // 1 - along / limit, positive in the basin.
-            float wRiver = (limit2 - along2) * (s.inverseScale * s.inverseScale) / (1.0 + along * s.inverseScale);
+            float wRiver = (limit2 - along2) * (inverseScale * inverseScale) / (1.0 + along * inverseScale);
             acc.inRiver = true;
             acc.inRiverSum += wRiver * factor * basinDepth;
             acc.inRiverWSum += wRiver;
             // d / |d| without another square root: inverseScale x halfWidth = 1 / |d| (and d = 0 stays 0).
-            acc.flowSum += wRiver * (d * (s.inverseScale * s.halfWidth));
+            acc.flowSum += wRiver * (d * (inverseScale * s.halfWidth));
         }
         if (dist2 < acc.minDistance2) {
             acc.minDistance2 = dist2;
             acc.minDistance = side > 0.0 ? -dist : dist;
+            acc.nearestReach = reach;
+            acc.nearestHalfWidth = s.halfWidth;
         }
     }
 }
@@ -188,7 +196,9 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
 
         float height = acc.heightSum / acc.weightSum;
         float basin = acc.basinSum / acc.weightSum;
-        riverWidth = acc.widthSum / acc.weightSum;
+        // Beyond the thesis: a vertex nearest to a sample with its own, shorter reach (a finer level's stream) has
+        // that stream's width, not the mean with the wide river whose valley it runs down.
+        riverWidth = acc.nearestReach < params.influenceDistance ? acc.nearestHalfWidth : acc.widthSum / acc.weightSum;
         if (acc.inRiver) {
             flow = acc.flowSum / acc.inRiverWSum;
             float inRiverBasin = acc.inRiverSum / acc.inRiverWSum;
@@ -196,7 +206,7 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
                     heights = vec4(height + inRiverBasin, 0.0, max(params.seaLevel, height + heightOffset), acc.minDistance);
         } else {
             float terrainHeight = height + basin;
-            float divisor = params.influenceDistance - riverWidth;
+            float divisor = acc.nearestReach - riverWidth;
             float lerpFactor = divisor > 0.0 ? clamp((abs(acc.minDistance) - riverWidth) / divisor, 0.0, 1.0) : 0.0;
                     heights = vec4(terrainHeight, lerpFactor, max(params.seaLevel, terrainHeight - params.basinWaterOffset),
                         acc.minDistance);

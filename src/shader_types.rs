@@ -19,7 +19,10 @@ pub struct RiverSample {
     pub derivative: [f32; 2],
     pub height: f32,
     pub width: f32,
-    pub _pad: [f32; 2],
+    /// Beyond the thesis: the sample's own influence distance (0: the kernel's `influence-distance`, which bounds
+    /// it). The streams of finer levels reach less far, so the thousands of them do not flatten the hills between.
+    pub reach: f32,
+    pub _pad: f32,
 }
 
 const _: () = assert!(size_of::<RiverSample>() == 32);
@@ -32,8 +35,14 @@ impl RiverSample {
             derivative,
             height,
             width,
-            _pad: [0.0; 2],
+            reach: 0.0,
+            _pad: 0.0,
         }
+    }
+
+    /// The sample with its own influence distance (0: the kernel's).
+    pub fn with_reach(self, reach: f32) -> Self {
+        Self { reach, ..self }
     }
 }
 

@@ -279,3 +279,55 @@ fn the_thesis_model_stays_selectable() {
     assert!(!world.planet.mountains.is_empty());
     assert!(!world.network.systems.is_empty());
 }
+
+/// `stream-levels` 1: the level above the base lattice draws its own streams (docs/rivers.md, "Rivers at every
+/// scale"): many, never rising, without procedural tributaries, in the samples of patches of their level and
+/// finer only, and a coarser patch near them does not hand its samples down as final (10.2).
+#[test]
+fn finer_levels_draw_their_own_streams_from_their_level_on() {
+    use riverplanet::{
+        planet::cube::PatchId,
+        river::{
+            network::MAX_GENERATION,
+            samples::{patch_samples, PatchFrame},
+        },
+    };
+    let mut config = drainage_config();
+    config.river.stream_levels = 1;
+    let world = riverplanet::world::World::build(&config, 1).unwrap();
+    let base = world.planet.drainage.as_ref().unwrap();
+    let [level] = world.network.streams.as_slice() else {
+        panic!("one level of streams");
+    };
+    assert_eq!(level.level, world.planet.stats.base_level + 1);
+    println!(
+        "level {}: {} stream reaches in {} systems ({} base reaches)",
+        level.level,
+        level.reaches,
+        level.systems.len(),
+        base.reaches.len()
+    );
+    assert!(
+        level.reaches >= base.reaches.len(),
+        "a level adds at least as many reaches as the base network has"
+    );
+    for system in &level.systems {
+        assert!(system.reach > 0.0 && system.reach < config.river.influence_distance);
+        for segment in &system.segments {
+            assert!(segment.heights.0 >= segment.heights.1, "a stream bed rises");
+            assert_eq!(segment.generation, MAX_GENERATION);
+        }
+    }
+    let segment = &level.systems[0].segments[0];
+    let p = level.systems[0].frame.to_sphere(segment.curve.p0);
+    let n = config.rendering.vertices;
+    let samples = |l: u8| {
+        let frame = PatchFrame::new(PatchId::containing(p, l), world.planet.radius, n);
+        patch_samples(&world.network, &frame)
+    };
+    let (coarse, fine) = (samples(level.level as u8 - 1), samples(level.level as u8));
+    assert!(coarse.samples.iter().all(|s| s.reach == 0.0));
+    assert!(!coarse.final_detail);
+    let reach = level.systems[0].reach;
+    assert!(fine.samples.iter().any(|s| s.reach == reach));
+}

@@ -95,6 +95,12 @@ pub fn generate(
     riverplanet::export::files::write_bytes(&path, serde_json::to_string(&geojson)?.as_bytes())?;
     let mut stats = planet.stats.clone();
     stats.timings_ms.insert("rivers".to_string(), river_ms);
+    // The finer levels' streams are routed within the rivers' stage; each level's share apart.
+    for level in &network.streams {
+        stats
+            .timings_ms
+            .insert(format!("streams level {}", level.level), level.ms);
+    }
     stats
         .timings_ms
         .insert(format!("face images level {level}"), faces_ms);
@@ -106,6 +112,11 @@ pub fn generate(
     value["tributaries"] = serde_json::json!(tributaries);
     value["abandoned_river_sources"] = serde_json::json!(network.abandoned_sources);
     value["rivers_geojson_lod"] = serde_json::json!(geojson_depth);
+    value["stream_levels"] = network
+        .streams
+        .iter()
+        .map(|l| serde_json::json!({ "level": l.level, "reaches": l.reaches, "systems": l.systems.len() }))
+        .collect();
     if let Some(drainage) = &planet.drainage {
         // The drainage model's measures, at the top level (docs/rivers.md).
         if let serde_json::Value::Object(measures) = serde_json::to_value(&drainage.measures)? {

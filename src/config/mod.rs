@@ -154,6 +154,9 @@ pub struct RiverConfig {
     /// rule). On a planet whose rivers are many orders of magnitude narrower than a coarse patch, the thesis's
     /// rule gives a coarse patch millions of samples for detail its vertices cannot show.
     pub samples_per_vertex_spacing: u32,
+    /// Drainage model: patch levels above the base lattice's whose own streams are drawn (each routed anew,
+    /// docs/rivers.md "Rivers at every scale"); 0 draws the base network alone.
+    pub stream_levels: u32,
 }
 
 /// How the level of detail picks a patch's level (6.2.1).
@@ -273,6 +276,7 @@ impl Config {
                 max_attempts: 16,
                 samples_per_half_width: 3,
                 samples_per_vertex_spacing: 0,
+                stream_levels: 0,
             },
             rendering: RenderingConfig {
                 vertices: 33,

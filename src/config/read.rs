@@ -154,6 +154,12 @@ const RIVER: &[Param<RiverConfig>] = &[
     Param::Whole("samples-per-vertex-spacing", 0, 64, |c| {
         &mut c.samples_per_vertex_spacing
     }),
+    Param::Whole(
+        "stream-levels",
+        0,
+        crate::drainage::finer::MAX_LEVELS_ABOVE_BASE,
+        |c| &mut c.stream_levels,
+    ),
 ];
 
 /// `<rendering-attributes>`.

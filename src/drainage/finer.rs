@@ -6,7 +6,10 @@
 //! uphill step, no crossing (both measured, [`super::rivers::DrainageMeasures`]).
 
 use super::{drain, grid::SphereGrid, Drainage};
-use crate::{config::Config, planet::Planet};
+use crate::{
+    config::Config,
+    planet::{heights::FaceLattice, Planet},
+};
 
 /// Levels above the base lattice's at which the network can be made: two levels is 16 times the base lattice's
 /// points (1.6 million on the default planet: about 5 s and 1 GB).
@@ -20,9 +23,19 @@ pub fn network_at(planet: &Planet, config: &Config, level: u32) -> Option<Draina
         return Some(base.clone());
     }
     let mut lattice = planet.face_lattice(level);
-    let grid = SphereGrid::new(&lattice);
+    Some(drain_lattice(planet, config, level, &mut lattice))
+}
+
+/// [`network_at`] above the base level, on `lattice` (that level's heights), which gets the carved beds.
+pub fn drain_lattice(
+    planet: &Planet,
+    config: &Config,
+    level: u32,
+    lattice: &mut FaceLattice,
+) -> Drainage {
+    let grid = SphereGrid::new(lattice);
     let mut river = config.river.clone();
     // The base rule (a stream where `source-area` drains) in cells of this level: a quarter per level.
     river.source_area /= 4f32.powi((level - planet.stats.base_level) as i32);
-    Some(drain(&mut lattice, &grid, &config.planet, &river))
+    drain(lattice, &grid, &config.planet, &river)
 }

@@ -8,6 +8,7 @@ pub mod grid;
 pub mod meanders;
 pub mod rivers;
 pub mod routing;
+pub mod streams;
 pub mod valleys;
 
 use glam::DVec3;

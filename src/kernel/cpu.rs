@@ -27,6 +27,8 @@ pub struct SampleContribution {
     pub dist: f32,
     /// The squared distance: the nearest sample is chosen on it, exactly alike on every device.
     pub dist2: f32,
+    /// The sample's influence distance (beyond the thesis: [`RiverSample::reach`]).
+    pub reach: f32,
     /// Beyond the thesis: the sample's unit direction (downstream) times `w_river`, for the water's flow.
     pub flow: [f32; 2],
 }
@@ -52,7 +54,11 @@ pub fn calculate_height_by_sample(
     let d = sample.derivative;
     let r = [v[0] - p[0], v[1] - p[1]];
     let dist2 = r[0] * r[0] + r[1] * r[1];
-    let reach = params.influence_distance;
+    let reach = if sample.reach > 0.0 {
+        sample.reach
+    } else {
+        params.influence_distance
+    };
     // Strict: a sample at exactly the influence distance has weight 0 and changes nothing but the sentinels.
     if dist2 >= reach * reach {
         return None;
@@ -88,6 +94,7 @@ pub fn calculate_height_by_sample(
         w_river: 0.0,
         dist: if side > 0.0 { -dist } else { dist },
         dist2,
+        reach,
         flow: [0.0; 2],
     };
     // projection distance < half width and normal distance <= half width.
@@ -121,6 +128,10 @@ pub struct Accumulators {
     pub min_distance: f32,
     /// The square of `min_distance`.
     pub min_distance2: f32,
+    /// The influence distance of the nearest sample: the lerp factor reaches 1 there.
+    pub nearest_reach: f32,
+    /// The half width of the nearest sample.
+    pub nearest_half_width: f32,
     /// Beyond the thesis: the highest water level of the lake samples within half their width of the vertex
     /// (`-f32::MAX` where none is).
     pub lake_level: f32,
@@ -143,6 +154,8 @@ pub fn accumulate_height(
         in_river_w_sum: 0.0,
         min_distance: f32::MAX,
         min_distance2: f32::MAX,
+        nearest_reach: params.influence_distance,
+        nearest_half_width: 0.0,
         lake_level: -f32::MAX,
         flow_sum: [0.0; 2],
     };
@@ -174,6 +187,8 @@ pub fn accumulate_height(
         if c.dist2 < acc.min_distance2 {
             acc.min_distance2 = c.dist2;
             acc.min_distance = c.dist;
+            acc.nearest_reach = c.reach;
+            acc.nearest_half_width = sample.width * 0.5;
         }
     }
     acc
@@ -220,7 +235,13 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
     }
     let height = acc.height_sum / acc.weight_sum;
     let basin = acc.basin_sum / acc.weight_sum;
-    let river_width = acc.width_sum / acc.weight_sum;
+    // Beyond the thesis: a vertex nearest to a sample with its own, shorter reach (a finer level's stream) has
+    // that stream's width, not the mean with the wide river whose valley it runs down.
+    let river_width = if acc.nearest_reach < params.influence_distance {
+        acc.nearest_half_width
+    } else {
+        acc.width_sum / acc.weight_sum
+    };
     let (terrain_height, lerp_factor, water_height) = if acc.in_river {
         let in_river_basin = acc.in_river_sum / acc.in_river_w_sum;
         let height_offset = basin - params.basin_water_offset;
@@ -231,7 +252,7 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
         )
     } else {
         let terrain_height = height + basin;
-        let divisor = params.influence_distance - river_width;
+        let divisor = acc.nearest_reach - river_width;
         let lerp = if divisor > 0.0 {
             ((acc.min_distance.abs() - river_width) / divisor).clamp(0.0, 1.0)
         } else {

@@ -454,7 +454,7 @@ impl Planet {
 }
 
 /// The height of `lattice` at a unit direction, bilinear between its points.
-fn height_on(lattice: &FaceLattice, direction: DVec3) -> f32 {
+pub fn height_on(lattice: &FaceLattice, direction: DVec3) -> f32 {
     let (face, u, v) = cube::face_of(direction);
     let c = lattice.cells as f64;
     let x = ((u + 1.0) * 0.5 * c).clamp(0.0, c);

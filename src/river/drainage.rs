@@ -6,12 +6,20 @@
 use glam::{DVec2, DVec3};
 
 use super::{
-    network::{enclose, RiverFrame, RiverSystem, Segment, SubdivisionParams, MAX_DEPTH},
+    network::{
+        enclose, RiverFrame, RiverSystem, Segment, StreamLevel, SubdivisionParams, MAX_DEPTH,
+        MAX_GENERATION,
+    },
     spline::Hermite,
 };
 use crate::{
     config::Config,
-    drainage::{Drainage, LakeShape},
+    drainage::{
+        finer,
+        streams::{lay_beds, new_streams, Courses, StreamRule},
+        Drainage, LakeShape, ReachPath,
+    },
+    planet::{cube::PatchId, height_on, Planet},
     rng,
 };
 
@@ -21,6 +29,8 @@ const SYSTEM_ANGLE: f64 = 0.3;
 /// Subdivision levels in a drainage system's hull at most: its segments are a few lattice cells long already, and
 /// the extended hull's margin covers whatever finer levels add.
 const DRAINAGE_HULL_LEVELS: u32 = 1;
+/// A finer level's stream joins a drawn course within this many cells of the coarser level.
+const JOIN_CELLS: f64 = 0.75;
 /// Points of a reach per Hermite segment (lattice nodes, or points of a meandering course).
 const NODES_PER_SEGMENT: usize = 2;
 
@@ -72,43 +82,10 @@ pub fn systems(
             let mouth = *reaches[root].points.last().unwrap();
             let source = trunk_head(drainage, &upstream, root);
             let frame = RiverFrame::new(mouth, source, radius);
-            let plane = |p: DVec3| frame.to_plane(p).unwrap_or_default();
-            let mut segments = Vec::new();
-            for &k in &members {
-                let reach = &reaches[k];
-                let points: Vec<DVec2> = reach.points.iter().map(|p| plane(*p)).collect();
-                // Where the reach joins another, it leaves along the other's first direction: C1 at the
-                // confluence (5.2.3).
-                let joins = reach.downstream.map(|d| {
-                    reaches[d]
-                        .points
-                        .iter()
-                        .map(|p| plane(*p))
-                        .collect::<Vec<_>>()
-                });
-                let knots: Vec<usize> = knot_indices(points.len());
-                for (s, pair) in knots.windows(2).enumerate() {
-                    let (a, b) = (pair[0], pair[1]);
-                    let tangent = |i: usize| tangent_at(&points, &knots, i, joins.as_deref());
-                    let span = (b - a) as f64;
-                    segments.push(Segment {
-                        curve: Hermite {
-                            p0: points[a],
-                            d0: tangent(a) * span,
-                            p1: points[b],
-                            d1: tangent(b) * span,
-                        },
-                        heights: (reach.beds[a], reach.beds[b]),
-                        widths: (width(reach.areas[a]), width(reach.areas[b])),
-                        key: rng::hash(branch(k), &[s as u64]),
-                        depth: 0,
-                        generation: 0,
-                        branch: branch(k),
-                        parent_branch: reach.downstream.map(branch),
-                        lake: false,
-                    });
-                }
-            }
+            let segments = members
+                .iter()
+                .flat_map(|&k| reach_segments(reaches, (k, 0), &frame, &width, &branch))
+                .collect();
             let hull_levels = config.river.hull_levels.min(DRAINAGE_HULL_LEVELS);
             enclose(
                 config,
@@ -125,6 +102,181 @@ pub fn systems(
         systems.push(lake_system(lake, id, radius, config, params));
     }
     systems
+}
+
+/// The Hermite segments of reach `k` in `frame`, two of its points long, tangents Catmull-Rom; where it joins
+/// another reach, it leaves along the other's first direction: C1 at the confluence (5.2.3). Pieces of
+/// `generation` [`MAX_GENERATION`] spawn no procedural tributaries.
+fn reach_segments(
+    reaches: &[ReachPath],
+    (k, generation): (usize, u32),
+    frame: &RiverFrame,
+    width: &impl Fn(f64) -> f32,
+    branch: &impl Fn(usize) -> u64,
+) -> Vec<Segment> {
+    let plane = |p: &DVec3| frame.to_plane(*p).unwrap_or_default();
+    let reach = &reaches[k];
+    let points: Vec<DVec2> = reach.points.iter().map(plane).collect();
+    let joins = reach
+        .downstream
+        .map(|d| reaches[d].points.iter().map(plane).collect::<Vec<_>>());
+    let knots: Vec<usize> = knot_indices(points.len());
+    knots
+        .windows(2)
+        .enumerate()
+        .map(|(s, pair)| {
+            let (a, b) = (pair[0], pair[1]);
+            let tangent = |i: usize| tangent_at(&points, &knots, i, joins.as_deref());
+            let span = (b - a) as f64;
+            Segment {
+                curve: Hermite {
+                    p0: points[a],
+                    d0: tangent(a) * span,
+                    p1: points[b],
+                    d1: tangent(b) * span,
+                },
+                heights: (reach.beds[a], reach.beds[b]),
+                widths: (width(reach.areas[a]), width(reach.areas[b])),
+                key: rng::hash(branch(k), &[s as u64]),
+                depth: 0,
+                generation,
+                branch: branch(k),
+                parent_branch: reach.downstream.map(branch),
+                lake: false,
+            }
+        })
+        .collect()
+}
+
+/// The streams a finer patch `level` adds ([`crate::drainage::streams`]) as river systems, ids from `first_id`:
+/// the streams whose trees end in one patch of the level below form one system, in a frame about that patch's
+/// centre (a few hundredths of a radian across, so the gnomonic frame is near exact), so a patch tests tens of
+/// systems rather than thousands of small trees, and each system's pieces only where its hull meets the patch.
+pub fn stream_systems(
+    streams: &[ReachPath],
+    (level, base_level, first_id): (u32, u32, u32),
+    drainage: &Drainage,
+    radius: f64,
+    config: &Config,
+    params: &SubdivisionParams,
+) -> Vec<RiverSystem> {
+    let bucket_level = level.saturating_sub(1) as u8;
+    let mut buckets: std::collections::BTreeMap<PatchId, Vec<usize>> = Default::default();
+    for k in 0..streams.len() {
+        let mut mouth = k;
+        while let Some(d) = streams[mouth].downstream {
+            mouth = d;
+        }
+        let end = *streams[mouth].points.last().unwrap();
+        buckets
+            .entry(PatchId::containing(end, bucket_level))
+            .or_default()
+            .push(k);
+    }
+    let width = |area: f64| reach_width(config, drainage, area);
+    let branch = |k: usize| rng::hash(params.seed, &[0x7374_7265, level as u64, k as u64]);
+    // Each level's streams carve valleys half as wide as the coarser level's: the river kernel pulls the terrain
+    // within its influence distance towards the bed, and streams a cell apart would otherwise level the hills
+    // between them.
+    let reach = config.river.influence_distance / 4f32.powi((level - base_level) as i32);
+    buckets
+        .into_iter()
+        .enumerate()
+        .map(|(id, (patch, members))| {
+            let centre = patch.center();
+            let frame = RiverFrame::new(centre, patch.corners()[0], radius);
+            let segments = members
+                .iter()
+                .flat_map(|&k| {
+                    reach_segments(streams, (k, MAX_GENERATION), &frame, &width, &branch)
+                })
+                .collect();
+            let hull_levels = config.river.hull_levels.min(DRAINAGE_HULL_LEVELS);
+            RiverSystem {
+                reach,
+                ..enclose(
+                    config,
+                    params,
+                    (first_id + id as u32, hull_levels),
+                    frame,
+                    segments,
+                    (centre, centre),
+                )
+            }
+        })
+        .collect()
+}
+
+/// The streams each level above the base lattice's adds, up to `stream-levels` levels above it: each level's
+/// network routed anew ([`crate::drainage::finer`]), and of it the streams no coarser level draws
+/// ([`crate::drainage::streams`]), joining the base rivers, the base lakes and the coarser levels' streams within
+/// three quarters of a coarser cell. System ids from `first_id`.
+pub fn stream_levels(
+    planet: &Planet,
+    config: &Config,
+    params: &SubdivisionParams,
+    first_id: u32,
+) -> Vec<StreamLevel> {
+    let Some(drainage) = &planet.drainage else {
+        return Vec::new();
+    };
+    let base = planet.stats.base_level;
+    let base_cell = std::f64::consts::FRAC_PI_2 / planet.lattice.cells as f64;
+    let mut drawn: Vec<ReachPath> = drainage.reaches.clone();
+    let mut levels = Vec::new();
+    let mut next_id = first_id;
+    for level in base + 1..=base + config.river.stream_levels {
+        let since = std::time::Instant::now();
+        let ground = planet.face_lattice(level);
+        let finer = finer::drain_lattice(planet, config, level, &mut ground.clone());
+        let coarser = (level - 1 - base) as i32;
+        let mut courses = Courses::new(JOIN_CELLS * base_cell / 2f64.powi(coarser));
+        courses.add_reaches(&drawn);
+        courses.add_lakes(&drainage.lakes);
+        let rule = StreamRule {
+            coarser_source_area: config.river.source_area as f64 / 4f64.powi(coarser),
+            sea_level: config.planet.sea_level_height,
+        };
+        let mut streams = new_streams(&finer.reaches, &courses, &rule);
+        // Within its influence distance the river kernel pulls the terrain towards a course's bed (6.6): a stream
+        // there lies on that valley side, not on the level's own ground, or it would stand above it and spill.
+        let influence = config.river.influence_distance as f64 / planet.radius;
+        let mut valleys = Courses::new(influence);
+        valleys.add_reaches(&drawn);
+        let basin = config.river.basin_depth;
+        lay_beds(&mut streams, |p| {
+            let own = height_on(&ground, p);
+            match valleys.nearest(p, influence) {
+                Some(course) => {
+                    let (bed, t) = (course.height, (p.distance(course.point) / influence) as f32);
+                    bed - basin + (own - bed + basin).max(0.0) * t
+                }
+                None => own,
+            }
+        });
+        let systems = stream_systems(
+            &streams,
+            (level, base, next_id),
+            drainage,
+            planet.radius,
+            config,
+            params,
+        );
+        next_id += systems.len() as u32;
+        log::info!(
+            "streams of level {level}: {} reaches in {} systems",
+            streams.len(),
+            systems.len()
+        );
+        levels.push(StreamLevel {
+            level,
+            reaches: streams.len(),
+            systems,
+            ms: since.elapsed().as_secs_f64() * 1e3,
+        });
+        drawn.extend(streams);
+    }
+    levels
 }
 
 /// A lake as a river system whose pieces carry its water level: one short straight piece through each of its

@@ -25,7 +25,7 @@ const STREAM_TRIBUTARY: u64 = 0x52_0003;
 /// The longest river, as an angle on the sphere: keeps every river well inside its frame's hemisphere.
 const MAX_RIVER_ANGLE: f64 = 0.6;
 /// Tributaries of tributaries at most.
-const MAX_GENERATION: u32 = 2;
+pub const MAX_GENERATION: u32 = 2;
 /// Deepest subdivision ever made.
 pub const MAX_DEPTH: u32 = 12;
 
@@ -260,6 +260,8 @@ pub struct RiverSystem {
     pub mouth: DVec3,
     /// Angular radius around `frame.centre` that contains the extended hull.
     pub cap_angle: f64,
+    /// Beyond the thesis: the influence distance of its samples (0: `influence-distance`, as the thesis).
+    pub reach: f32,
 }
 
 /// Every piece of a river system down to `depth`, tributaries included, in a deterministic order.
@@ -308,10 +310,25 @@ pub fn finest_piece_near(
     piece
 }
 
+/// The streams one finer level adds, as river systems.
+#[derive(Clone, Debug)]
+pub struct StreamLevel {
+    /// The patch level from which they are drawn.
+    pub level: u32,
+    pub systems: Vec<RiverSystem>,
+    /// Reaches (from a head or confluence to the next confluence, course or the sea).
+    pub reaches: usize,
+    /// Time taken to route the level and choose its streams, milliseconds.
+    pub ms: f64,
+}
+
 /// All river systems of a planet.
 #[derive(Clone, Debug)]
 pub struct RiverNetwork {
     pub systems: Vec<RiverSystem>,
+    /// The streams finer levels add (drainage model, beyond the thesis; docs/rivers.md "Rivers at every scale"),
+    /// coarsest level first: they influence patches of their level and finer.
+    pub streams: Vec<StreamLevel>,
     pub params: SubdivisionParams,
     pub hull_levels: u32,
     pub influence_distance: f64,
@@ -332,8 +349,9 @@ impl RiverNetwork {
     pub fn generate(planet: &Planet, config: &Config, seed: u32) -> Self {
         let params = SubdivisionParams::from_config(config, seed as u64);
         let r = &config.river;
-        let network = |systems, abandoned_sources| Self {
+        let network = |systems, streams, abandoned_sources| Self {
             systems,
+            streams,
             params,
             hull_levels: r.hull_levels,
             influence_distance: r.influence_distance as f64,
@@ -342,10 +360,10 @@ impl RiverNetwork {
             abandoned_sources,
         };
         if let Some(drainage) = &planet.drainage {
-            return network(
-                super::drainage::systems(drainage, planet.radius, config, &params),
-                0,
-            );
+            let systems = super::drainage::systems(drainage, planet.radius, config, &params);
+            let streams =
+                super::drainage::stream_levels(planet, config, &params, systems.len() as u32);
+            return network(systems, streams, 0);
         }
         let step = (0.25f64).to_radians();
         let mut systems: Vec<RiverSystem> = Vec::new();
@@ -376,7 +394,7 @@ impl RiverNetwork {
                 abandoned += 1;
             }
         }
-        network(systems, abandoned)
+        network(systems, Vec::new(), abandoned)
     }
 
     /// Rivers and tributaries down to `depth`.
@@ -519,6 +537,7 @@ pub fn enclose(
         source,
         mouth,
         cap_angle,
+        reach: 0.0,
     }
 }
 

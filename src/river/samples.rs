@@ -65,12 +65,33 @@ pub fn influences(system: &RiverSystem, frame: &PatchFrame) -> bool {
         .is_some_and(|outline| hull::intersects(&system.extended, &outline))
 }
 
-/// The systems that influence a patch.
+/// The systems that influence a patch: the network's, and the streams of its level and coarser ones.
 pub fn influencing<'a>(
     network: &'a RiverNetwork,
     frame: &'a PatchFrame,
 ) -> impl Iterator<Item = &'a RiverSystem> {
-    network.systems.iter().filter(move |s| influences(s, frame))
+    let level = frame.patch.level as u32;
+    let streams = network
+        .streams
+        .iter()
+        .filter(move |s| s.level <= level)
+        .flat_map(|s| &s.systems);
+    network
+        .systems
+        .iter()
+        .chain(streams)
+        .filter(move |s| influences(s, frame))
+}
+
+/// Whether streams of a finer level than the patch's reach it: then its descendants get samples it has not.
+fn finer_streams_reach(network: &RiverNetwork, frame: &PatchFrame) -> bool {
+    let level = frame.patch.level as u32;
+    network
+        .streams
+        .iter()
+        .filter(|s| s.level > level)
+        .flat_map(|s| &s.systems)
+        .any(|s| influences(s, frame))
 }
 
 /// A patch's river samples, and whether they are the rivers' final detail.
@@ -131,7 +152,7 @@ pub fn patch_samples(network: &RiverNetwork, frame: &PatchFrame) -> PatchSamples
     }
     PatchSamples {
         samples: out,
-        final_detail,
+        final_detail: final_detail && !finer_streams_reach(network, frame),
     }
 }
 
@@ -201,7 +222,8 @@ pub fn piece_samples<'a>(
             piece.height_at(t),
             // A lake's samples say what they are by a negative width (RiverSample).
             (width * stretch) as f32 * if piece.lake { -1.0 } else { 1.0 },
-        );
+        )
+        .with_reach(system.reach);
         t += sample_step(network, width).max(floor) / speed;
         Some((p, sample))
     })
