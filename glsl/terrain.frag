@@ -195,7 +195,7 @@ vec3 rippleSpace(bool river, out float visible) {
 // at most sqrt(2) (a right triangle's interpolant of a 1-Lipschitz field). Where they measure different rivers, or
 // one measures none (the influence distance's default) or sits beyond a river's end (the sign flips there), the
 // vertices' distances differ by more than their separation and the interpolant crosses zero where no river is.
-// `dz`: the distance's screen derivatives. Call in uniform control flow.
+// `dz`: the distance's screen derivatives (or another interpolant's: riverSlope). Call in uniform control flow.
 float distanceSlope(vec2 dz) {
     vec3 px = dFdx(fPosition);
     vec3 py = dFdy(fPosition);
@@ -208,6 +208,12 @@ float distanceSlope(vec2 dz) {
 // Beyond the thesis: the largest slope at which an interpolated distance is taken for a river's (sqrt 2 and a
 // margin for the curvature of the mesh on the sphere).
 const float RIVER_SLOPE_LIMIT = 1.6;
+// Beyond the thesis: the largest change of the river half width per unit of length at which a triangle is taken
+// to measure one river. Along one river the width changes by a fraction of a percent per unit; a triangle with a
+// vertex nearest a finer level's stream (its own narrow width, docs/kernel.md) and one nearest the wide river
+// beside it changes by about the river's width over the vertex spacing, and its interpolated distance is no
+// river's.
+const float WIDTH_SLOPE_LIMIT = 0.25;
 
 void main() {
     vec3 sun = normalize(frame.sun.xyz);
@@ -232,7 +238,8 @@ void main() {
     float edge = abs(dz.x) + abs(dz.y) + 1e-4;
     float shoreEdge = fwidth(fRiver.x) + 1e-6;
     float bankEdge = fwidth(fRiver.y - fRiver.x) + 1e-6;
-    bool measured = distanceSlope(dz) <= RIVER_SLOPE_LIMIT;
+    vec2 dw = vec2(dFdx(fRiver.w), dFdy(fRiver.w));
+    bool measured = distanceSlope(dz) <= RIVER_SLOPE_LIMIT && distanceSlope(dw) <= WIDTH_SLOPE_LIMIT;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).

@@ -15,6 +15,16 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// Whether `line` has `word` as a whole path segment: not the end of a longer name (`hash::` is not `ash::`).
+fn names(line: &str, word: &str) -> bool {
+    line.match_indices(word).any(|(at, _)| {
+        !line[..at]
+            .chars()
+            .next_back()
+            .is_some_and(|c| c.is_alphanumeric() || c == '_')
+    })
+}
+
 /// Every source file that `checked` accepts (by its path under the repository) and that contains one of `words`
 /// outside comments, with the first such line.
 fn offenders_where(words: &[&str], checked: impl Fn(&str) -> bool) -> Vec<String> {
@@ -37,7 +47,7 @@ fn offenders_where(words: &[&str], checked: impl Fn(&str) -> bool) -> Vec<String
             text.lines()
                 .enumerate()
                 .filter(|(_, line)| !line.trim_start().starts_with("//"))
-                .find(|(_, line)| words.iter().any(|w| line.contains(w)))
+                .find(|(_, line)| words.iter().any(|w| names(line, w)))
                 .map(|(n, line)| format!("{relative}:{}: {}", n + 1, line.trim()))
         })
         .collect()
@@ -108,4 +118,16 @@ fn only_the_command_line_names_clap() {
         "clap outside the command line:\n{}",
         found.join("\n")
     );
+}
+
+#[test]
+fn a_name_is_found_only_as_a_whole_path_segment() {
+    assert!(names("use ash::vk;", "ash::"));
+    assert!(names("let x: ash::Device = d;", "ash::"));
+    assert!(names("    vk::Format::R8", "vk::"));
+    assert!(!names(
+        "use std::hash::{BuildHasherDefault, Hasher};",
+        "ash::"
+    ));
+    assert!(!names("let m = mvk::x;", "vk::"));
 }

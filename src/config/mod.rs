@@ -231,6 +231,7 @@ impl Config {
             d.planet.detail_amplitude = 2.0;
             d.river.source_area = d.planet.relief_model.source_area();
             d.river.samples_per_vertex_spacing = 4;
+            d.river.stream_levels = 1;
             d.rendering.level_of_detail_rule = LodRule::ScreenSpaceError;
         }
         d

@@ -5,7 +5,7 @@
 //! downhill on that level's heights into the rivers they join, with the same guarantees as the base network: no
 //! uphill step, no crossing (both measured, [`super::rivers::DrainageMeasures`]).
 
-use super::{drain, grid::SphereGrid, Drainage};
+use super::{drain_paths, grid::SphereGrid, meander_reaches, Drainage};
 use crate::{
     config::Config,
     planet::{heights::FaceLattice, Planet},
@@ -23,11 +23,20 @@ pub fn network_at(planet: &Planet, config: &Config, level: u32) -> Option<Draina
         return Some(base.clone());
     }
     let mut lattice = planet.face_lattice(level);
-    Some(drain_lattice(planet, config, level, &mut lattice))
+    let mut network = routed_at(planet, config, level, &mut lattice);
+    network.reaches = meander_reaches(
+        &network.reaches,
+        lattice.cells,
+        &config.planet,
+        &config.river,
+        network.largest_area,
+    );
+    Some(network)
 }
 
-/// [`network_at`] above the base level, on `lattice` (that level's heights), which gets the carved beds.
-pub fn drain_lattice(
+/// [`network_at`] above the base level before its rivers meander (along their lattice paths), on `lattice`
+/// (that level's heights), which gets the carved beds.
+pub fn routed_at(
     planet: &Planet,
     config: &Config,
     level: u32,
@@ -37,5 +46,5 @@ pub fn drain_lattice(
     let mut river = config.river.clone();
     // The base rule (a stream where `source-area` drains) in cells of this level: a quarter per level.
     river.source_area /= 4f32.powi((level - planet.stats.base_level) as i32);
-    drain(lattice, &grid, &config.planet, &river)
+    drain_paths(lattice, &grid, &config.planet, &river)
 }

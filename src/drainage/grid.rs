@@ -5,6 +5,8 @@
 
 use std::{cmp::Reverse, collections::BinaryHeap, collections::HashMap};
 
+use rayon::prelude::*;
+
 use glam::{DVec3, I64Vec3};
 
 use crate::planet::{
@@ -39,11 +41,18 @@ impl SphereGrid {
             for j in 0..=c {
                 for i in 0..=c {
                     let key = lattice.key(face, i, j);
-                    let id = *ids.entry(key).or_insert_with(|| {
+                    let mut add = || {
                         directions.push(lattice.direction(key));
                         areas.push(0.0);
                         directions.len() as u32 - 1
-                    });
+                    };
+                    // Only points on a face's border are shared with another face.
+                    let border = i == 0 || j == 0 || i == c || j == c;
+                    let id = if border {
+                        *ids.entry(key).or_insert_with(add)
+                    } else {
+                        add()
+                    };
                     areas[id as usize] += area_weight(c, i, j);
                     node_of[lattice.index(face, i, j)] = id;
                 }
@@ -74,7 +83,8 @@ impl SphereGrid {
             offsets.push(neighbours.len() as u32);
         }
         let angles = (0..directions.len())
-            .flat_map(|k| {
+            .into_par_iter()
+            .flat_map_iter(|k| {
                 let range = offsets[k] as usize..offsets[k + 1] as usize;
                 let here = directions[k];
                 let (neighbours, directions) = (&neighbours, &directions);

@@ -54,9 +54,27 @@ pub struct Drainage {
     pub largest_area: f64,
 }
 
-/// Routes the water of `lattice` (the base heights), extracts rivers and lakes, and carves valleys into
-/// `lattice` around the rivers.
+/// Routes the water of `lattice` (the base heights), extracts rivers and lakes, carves valleys into `lattice`
+/// around the rivers, and lets the rivers meander ([`meander_reaches`]).
 pub fn drain(
+    lattice: &mut FaceLattice,
+    grid: &SphereGrid,
+    planet: &PlanetConfig,
+    river: &RiverConfig,
+) -> Drainage {
+    let mut drainage = drain_paths(lattice, grid, planet, river);
+    drainage.reaches = meander_reaches(
+        &drainage.reaches,
+        grid.cells,
+        planet,
+        river,
+        drainage.largest_area,
+    );
+    drainage
+}
+
+/// [`drain`] with the reaches along their lattice paths.
+pub fn drain_paths(
     lattice: &mut FaceLattice,
     grid: &SphereGrid,
     planet: &PlanetConfig,
@@ -105,19 +123,6 @@ pub fn drain(
         .iter()
         .flat_map(|r| r.areas.iter().copied())
         .fold(0.0, f64::max);
-    // Rivers on the eroded relief meander through their valleys (the carved relief keeps the thesis-era paths).
-    let reaches = match planet.relief_model {
-        ReliefModel::Eroded => {
-            let scale = meanders::MeanderScale {
-                cell: std::f64::consts::FRAC_PI_2 / grid.cells as f64,
-                radius,
-                relief_slope: (planet.max_mountain_height - planet.sea_level_height) as f64
-                    / radius,
-            };
-            meanders::meander_all(&reaches, &scale, |a| width(river, largest_area, a) as f64)
-        }
-        _ => reaches,
-    };
     let lakes = network
         .lakes
         .iter()
@@ -137,6 +142,30 @@ pub fn drain(
         lakes,
         measures: network.measures,
         largest_area,
+    }
+}
+
+/// Rivers on the eroded relief meander through their valleys (the carved relief keeps the thesis-era paths):
+/// `reaches` on a lattice of `cells` cells per face edge, widths against `largest_area`.
+pub fn meander_reaches(
+    reaches: &[ReachPath],
+    cells: u32,
+    planet: &PlanetConfig,
+    river: &RiverConfig,
+    largest_area: f64,
+) -> Vec<ReachPath> {
+    match planet.relief_model {
+        ReliefModel::Eroded => {
+            let radius = planet.radius as f64;
+            let scale = meanders::MeanderScale {
+                cell: std::f64::consts::FRAC_PI_2 / cells as f64,
+                radius,
+                relief_slope: (planet.max_mountain_height - planet.sea_level_height) as f64
+                    / radius,
+            };
+            meanders::meander_all(reaches, &scale, |a| width(river, largest_area, a) as f64)
+        }
+        _ => reaches.to_vec(),
     }
 }
 

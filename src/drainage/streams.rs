@@ -1,23 +1,51 @@
 //! The streams a finer level adds to the drawn network (beyond the thesis; docs/rivers.md, "Rivers at every
 //! scale"). Of the network routed again at a finer level ([`super::finer::network_at`]), only what the coarser
 //! levels do not draw yet is new: every stream from its head down to where it comes within a join distance of a
-//! drawn course (a river, a stream of a coarser level, a lake), where it ends on that course, its bed no higher
-//! than the course's there. The finer network's copies of the drawn rivers (re-routed, within about a cell of
+//! drawn course (a river, a stream of a coarser level, a lake), or where, within a river's valley (the river
+//! kernel's influence distance), it stops heading towards the river; there it ends on that course, its bed no
+//! higher than the course's. The finer network's copies of the drawn rivers (re-routed, within about a cell of
 //! them) start at or beside a drawn course and so add nothing. Left out, with every stream above it: a stream that
 //! grows to a river of the coarser level without meeting a drawn course (a re-routed copy that strayed further),
 //! and a stream that ends in a lake only the finer level holds (it would end in nothing drawn).
 
-use std::collections::HashMap;
+use std::{
+    collections::HashMap,
+    hash::{BuildHasherDefault, Hasher},
+};
 
 use glam::{DVec3, IVec3};
 
 use super::{LakeShape, ReachPath};
 
-/// The drawn courses, as points on the unit sphere with their bed (or lake) heights, in a grid of cells as wide
-/// as the distance at which a stream joins them.
+/// The drawn courses, as points on the unit sphere with their bed (or lake) heights, in a grid of cells.
 pub struct Courses {
-    join: f64,
-    cells: HashMap<IVec3, Vec<Course>>,
+    cell: f64,
+    cells: HashMap<IVec3, Vec<Course>, BuildHasherDefault<CellHasher>>,
+}
+
+/// A multiply-rotate hash of a grid cell's three integers (the Fx hash): the default SipHash made the queries of
+/// a level's hundreds of thousands of stream points a third of its time.
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u32(b as u32);
+        }
+    }
+
+    fn write_i32(&mut self, i: i32) {
+        self.write_u32(i as u32);
+    }
+
+    fn write_u32(&mut self, i: u32) {
+        self.0 = (self.0.rotate_left(5) ^ i as u64).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
 }
 
 /// A point of a drawn course.
@@ -26,47 +54,55 @@ pub struct Course {
     pub point: DVec3,
     /// The bed's height, or a lake's level.
     pub height: f32,
+    /// Half the river's width (radians; 0 for a lake).
+    pub half_width: f64,
     pub lake: bool,
 }
 
 impl Courses {
-    /// An empty set of courses, joined within `join` (radians).
-    pub fn new(join: f64) -> Self {
+    /// An empty set of courses, found fastest within `cell` (radians) of a point.
+    pub fn new(cell: f64) -> Self {
         Self {
-            join,
-            cells: HashMap::new(),
+            cell,
+            cells: HashMap::default(),
         }
     }
 
     fn key(&self, p: DVec3) -> IVec3 {
-        (p / self.join).floor().as_ivec3()
+        (p / self.cell).floor().as_ivec3()
     }
 
-    fn insert(&mut self, point: DVec3, height: f32, lake: bool) {
-        let key = self.key(point);
-        self.cells.entry(key).or_default().push(Course {
-            point,
-            height,
-            lake,
-        });
+    fn insert(&mut self, course: Course) {
+        let key = self.key(course.point);
+        self.cells.entry(key).or_default().push(course);
     }
 
-    /// Adds every reach's course, with points no more than an eighth of the join distance apart, beds between
-    /// the course's points linear.
-    pub fn add_reaches(&mut self, reaches: &[ReachPath]) {
-        let step = self.join / 8.0;
+    /// Adds every reach's course, with points no more than `step` (radians) apart, beds and drainage areas
+    /// between the course's points linear; `half_width(area)` in radians.
+    pub fn add_reaches(
+        &mut self,
+        reaches: &[ReachPath],
+        step: f64,
+        half_width: impl Fn(f64) -> f64,
+    ) {
         for reach in reaches {
             for i in 0..reach.points.len() {
-                let (a, bed_a) = (reach.points[i], reach.beds[i]);
-                self.insert(a, bed_a, false);
-                let Some((&b, &bed_b)) = reach.points.get(i + 1).zip(reach.beds.get(i + 1)) else {
-                    continue;
+                let j = (i + 1).min(reach.points.len() - 1);
+                let (a, b) = (reach.points[i], reach.points[j]);
+                let pieces = if j == i {
+                    1
+                } else {
+                    (a.distance(b) / step).ceil() as usize
                 };
-                let pieces = (a.distance(b) / step).ceil() as usize;
-                for k in 1..pieces {
+                for k in 0..pieces {
                     let t = k as f64 / pieces as f64;
-                    let bed = bed_a + (bed_b - bed_a) * t as f32;
-                    self.insert(a.lerp(b, t).normalize(), bed, false);
+                    let area = reach.areas[i] + (reach.areas[j] - reach.areas[i]) * t;
+                    self.insert(Course {
+                        point: a.lerp(b, t).normalize(),
+                        height: reach.beds[i] + (reach.beds[j] - reach.beds[i]) * t as f32,
+                        half_width: half_width(area),
+                        lake: false,
+                    });
                 }
             }
         }
@@ -76,15 +112,20 @@ impl Courses {
     pub fn add_lakes(&mut self, lakes: &[LakeShape]) {
         for lake in lakes {
             for &p in &lake.points {
-                self.insert(p, lake.level, true);
+                self.insert(Course {
+                    point: p,
+                    height: lake.level,
+                    half_width: 0.0,
+                    lake: true,
+                });
             }
         }
     }
 
-    /// The nearest course point within `within` (radians) of `p`.
-    pub fn nearest(&self, p: DVec3, within: f64) -> Option<Course> {
+    /// The nearest course point within `within` (radians) of `p`, and its distance.
+    pub fn nearest(&self, p: DVec3, within: f64) -> Option<(Course, f64)> {
         let key = self.key(p);
-        let r = (within / self.join).ceil() as i32;
+        let r = (within / self.cell).ceil() as i32;
         let mut best: Option<(f64, Course)> = None;
         for dx in -r..=r {
             for dy in -r..=r {
@@ -101,7 +142,7 @@ impl Courses {
                 }
             }
         }
-        best.map(|(_, course)| course)
+        best.map(|(d, course)| (course, d))
     }
 }
 
@@ -112,12 +153,17 @@ pub struct StreamRule {
     pub coarser_source_area: f64,
     /// The sea level: a stream whose bed ends there reaches the sea.
     pub sea_level: f32,
+    /// The distance (radians) within which a stream joins a course.
+    pub join: f64,
+    /// The river kernel's influence distance (radians): within it, a stream that stops heading towards the river
+    /// joins it, rather than run down its valley beside it.
+    pub valley: f64,
 }
 
 /// How far a reach of the finer network goes as a new stream.
 #[derive(Clone, Copy)]
 enum Fate {
-    /// Its first `at` points, then the course point it joins.
+    /// Its points up to `at`, then the bank of the course it joins.
     Joins { at: usize, course: Course },
     /// All of it, on into the reach below or into the sea.
     Flows,
@@ -127,9 +173,9 @@ enum Fate {
 
 /// Where on its way to the course it joins a stream drops to the course's bed (a share of the way).
 const MOUTH_STEP: f64 = 0.1;
-/// Once a stream has the coarser level's source area, it joins a course this many join distances away: a
-/// re-routed copy of a drawn river runs beside it.
-const RIVER_JOIN_FACTOR: f64 = 2.5;
+/// Within a river's valley, a stream heads towards the river while its distance to it falls by at least this
+/// share of each step (a heading within 60 degrees of straight at it).
+const APPROACH: f64 = 0.5;
 /// A stream that has twice the coarser level's source area and still no course near is such a copy that strayed.
 const STRAYED_AREA_FACTOR: f64 = 2.0;
 
@@ -184,18 +230,18 @@ pub fn new_streams(finer: &[ReachPath], drawn: &Courses, rule: &StreamRule) -> V
                 downstream: None,
             },
             Fate::Joins { at, course } => {
-                // Into the course's valley at the course's bed: a step just past the last point, then straight on.
-                let last = reach.points[at - 1];
-                let mut points = reach.points[..at].to_vec();
-                points.extend([
-                    last.lerp(course.point, MOUTH_STEP).normalize(),
-                    course.point,
-                ]);
-                let mut beds = reach.beds[..at].to_vec();
-                let bed = course.height.min(beds[at - 1]);
+                // Into the course's valley at the course's bed: a step just past the last point, then straight on
+                // to the river's bank (its samples inside the river would narrow it: docs/kernel.md).
+                let last = reach.points[at];
+                let bank =
+                    course.point + (last - course.point).normalize_or_zero() * course.half_width;
+                let mut points = reach.points[..=at].to_vec();
+                points.extend([last.lerp(bank, MOUTH_STEP).normalize(), bank.normalize()]);
+                let mut beds = reach.beds[..=at].to_vec();
+                let bed = course.height.min(beds[at]);
                 beds.extend([bed, bed]);
-                let mut areas = reach.areas[..at].to_vec();
-                areas.extend([areas[at - 1]; 2]);
+                let mut areas = reach.areas[..=at].to_vec();
+                areas.extend([areas[at]; 2]);
                 ReachPath {
                     points,
                     beds,
@@ -234,16 +280,21 @@ pub fn lay_beds(streams: &mut [ReachPath], ground: impl Fn(DVec3) -> f32) {
 
 /// Walks `reach` downstream until it comes near a drawn course.
 fn fate(reach: &ReachPath, drawn: &Courses, rule: &StreamRule) -> Fate {
+    let mut before: Option<(DVec3, f64)> = None;
     for (i, (&p, &area)) in reach.points.iter().zip(&reach.areas).enumerate() {
-        let river = area >= rule.coarser_source_area;
-        let within = if river {
-            RIVER_JOIN_FACTOR * drawn.join
-        } else {
-            drawn.join
-        };
-        if let Some(course) = drawn.nearest(p, within) {
-            return Fate::Joins { at: i, course };
+        let near = drawn.nearest(p, rule.join.max(rule.valley));
+        if let Some((course, d)) = near {
+            let joins = d <= rule.join;
+            let beside = !course.lake
+                && d <= rule.valley
+                && before.is_some_and(|(q, was)| d > was - APPROACH * p.distance(q));
+            if joins || beside {
+                return Fate::Joins { at: i, course };
+            }
         }
+        before = near
+            .filter(|(course, d)| !course.lake && *d <= rule.valley)
+            .map(|(_, d)| (p, d));
         if area >= STRAYED_AREA_FACTOR * rule.coarser_source_area {
             return Fate::Left;
         }

@@ -15,7 +15,7 @@ use super::{
 use crate::{
     config::Config,
     drainage::{
-        finer,
+        finer, meander_reaches,
         streams::{lay_beds, new_streams, Courses, StreamRule},
         Drainage, LakeShape, ReachPath,
     },
@@ -191,13 +191,14 @@ pub fn stream_systems(
                     reach_segments(streams, (k, MAX_GENERATION), &frame, &width, &branch)
                 })
                 .collect();
-            let hull_levels = config.river.hull_levels.min(DRAINAGE_HULL_LEVELS);
+            // The hull of the segments themselves: thousands of short pieces, whose descendants the extended
+            // hull's margin covers.
             RiverSystem {
                 reach,
                 ..enclose(
                     config,
                     params,
-                    (first_id + id as u32, hull_levels),
+                    (first_id + id as u32, 0),
                     frame,
                     segments,
                     (centre, centre),
@@ -210,7 +211,8 @@ pub fn stream_systems(
 /// The streams each level above the base lattice's adds, up to `stream-levels` levels above it: each level's
 /// network routed anew ([`crate::drainage::finer`]), and of it the streams no coarser level draws
 /// ([`crate::drainage::streams`]), joining the base rivers, the base lakes and the coarser levels' streams within
-/// three quarters of a coarser cell. System ids from `first_id`.
+/// three quarters of a coarser cell, or where, within a river's valley, they stop heading towards it; they meander
+/// as the base rivers do. System ids from `first_id`.
 pub fn stream_levels(
     planet: &Planet,
     config: &Config,
@@ -221,37 +223,49 @@ pub fn stream_levels(
         return Vec::new();
     };
     let base = planet.stats.base_level;
-    let base_cell = std::f64::consts::FRAC_PI_2 / planet.lattice.cells as f64;
+    // A lattice cell of `level` (radians along a face's middle): the planet holds the lattice of its precomputed level.
+    let cell = |level: u32| {
+        std::f64::consts::FRAC_PI_2 / planet.lattice.cells as f64
+            * 2f64.powi(planet.precomputed_level as i32 - level as i32)
+    };
     let mut drawn: Vec<ReachPath> = drainage.reaches.clone();
     let mut levels = Vec::new();
     let mut next_id = first_id;
     for level in base + 1..=base + config.river.stream_levels {
         let since = std::time::Instant::now();
         let ground = planet.face_lattice(level);
-        let finer = finer::drain_lattice(planet, config, level, &mut ground.clone());
+        // Routed along lattice paths; only the streams kept meander.
+        let finer = finer::routed_at(planet, config, level, &mut ground.clone());
         let coarser = (level - 1 - base) as i32;
-        let mut courses = Courses::new(JOIN_CELLS * base_cell / 2f64.powi(coarser));
-        courses.add_reaches(&drawn);
-        courses.add_lakes(&drainage.lakes);
         let rule = StreamRule {
             coarser_source_area: config.river.source_area as f64 / 4f64.powi(coarser),
             sea_level: config.planet.sea_level_height,
+            join: JOIN_CELLS * cell(level - 1),
+            valley: config.river.influence_distance as f64 / planet.radius,
         };
-        let mut streams = new_streams(&finer.reaches, &courses, &rule);
+        let mut courses = Courses::new(rule.join.max(rule.valley));
+        courses.add_reaches(&drawn, rule.join / 4.0, |area| {
+            0.5 * reach_width(config, drainage, area) as f64 / planet.radius
+        });
+        courses.add_lakes(&drainage.lakes);
+        let mut streams = meander_reaches(
+            &new_streams(&finer.reaches, &courses, &rule),
+            ground.cells,
+            &config.planet,
+            &config.river,
+            drainage.largest_area,
+        );
         // Within its influence distance the river kernel pulls the terrain towards a course's bed (6.6): a stream
         // there lies on that valley side, not on the level's own ground, or it would stand above it and spill.
-        let influence = config.river.influence_distance as f64 / planet.radius;
-        let mut valleys = Courses::new(influence);
-        valleys.add_reaches(&drawn);
         let basin = config.river.basin_depth;
         lay_beds(&mut streams, |p| {
             let own = height_on(&ground, p);
-            match valleys.nearest(p, influence) {
-                Some(course) => {
-                    let (bed, t) = (course.height, (p.distance(course.point) / influence) as f32);
+            match courses.nearest(p, rule.valley) {
+                Some((course, d)) if !course.lake => {
+                    let (bed, t) = (course.height, (d / rule.valley) as f32);
                     bed - basin + (own - bed + basin).max(0.0) * t
                 }
-                None => own,
+                _ => own,
             }
         });
         let systems = stream_systems(
