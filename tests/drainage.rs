@@ -321,11 +321,14 @@ fn finer_levels_draw_their_own_streams_from_their_level_on() {
     let segment = &level.systems[0].segments[0];
     let p = level.systems[0].frame.to_sphere(segment.curve.p0);
     let n = config.rendering.vertices;
-    let samples = |l: u8| {
-        let frame = PatchFrame::new(PatchId::containing(p, l), world.planet.radius, n);
-        patch_samples(&world.network, &frame)
-    };
-    let (coarse, fine) = (samples(level.level as u8 - 1), samples(level.level as u8));
+    let frame = |l: u8| PatchFrame::new(PatchId::containing(p, l), world.planet.radius, n);
+    // Drawn from the first level whose vertices lie no further apart than the streams' influence distance.
+    let first = (level.level as u8..)
+        .find(|&l| frame(l).spacing() <= level.systems[0].reach as f64)
+        .unwrap();
+    println!("drawn from level {first}");
+    let samples = |l: u8| patch_samples(&world.network, &frame(l));
+    let (coarse, fine) = (samples(first - 1), samples(first));
     assert!(coarse.samples.iter().all(|s| s.reach == 0.0));
     assert!(!coarse.final_detail);
     let reach = level.systems[0].reach;

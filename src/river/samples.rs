@@ -65,17 +65,17 @@ pub fn influences(system: &RiverSystem, frame: &PatchFrame) -> bool {
         .is_some_and(|outline| hull::intersects(&system.extended, &outline))
 }
 
-/// The systems that influence a patch: the network's, and the streams of its level and coarser ones.
+/// The systems that influence a patch: the network's, and the streams a patch of its level draws.
 pub fn influencing<'a>(
     network: &'a RiverNetwork,
     frame: &'a PatchFrame,
 ) -> impl Iterator<Item = &'a RiverSystem> {
-    let level = frame.patch.level as u32;
     let streams = network
         .streams
         .iter()
-        .filter(move |s| s.level <= level)
-        .flat_map(|s| &s.systems);
+        .flat_map(|s| s.systems.iter().map(move |system| (s.level, system)))
+        .filter(move |(level, system)| drawn_on(*level, system, frame))
+        .map(|(_, system)| system);
     network
         .systems
         .iter()
@@ -83,15 +83,20 @@ pub fn influencing<'a>(
         .filter(move |s| influences(s, frame))
 }
 
-/// Whether streams of a finer level than the patch's reach it: then its descendants get samples it has not.
+/// Whether a patch draws the streams of `level` in `system`: from their level on, once its vertices lie no
+/// further apart than the streams' influence distance. A coarser patch would carve a stream's valley into the odd
+/// vertex that happens to lie within its reach, a pit where no valley shows.
+fn drawn_on(level: u32, system: &RiverSystem, frame: &PatchFrame) -> bool {
+    frame.patch.level as u32 >= level && frame.spacing() <= system.reach as f64
+}
+
+/// Whether streams the patch does not draw yet reach it: then its descendants get samples it has not.
 fn finer_streams_reach(network: &RiverNetwork, frame: &PatchFrame) -> bool {
-    let level = frame.patch.level as u32;
     network
         .streams
         .iter()
-        .filter(|s| s.level > level)
-        .flat_map(|s| &s.systems)
-        .any(|s| influences(s, frame))
+        .flat_map(|s| s.systems.iter().map(move |system| (s.level, system)))
+        .any(|(level, system)| !drawn_on(level, system, frame) && influences(system, frame))
 }
 
 /// A patch's river samples, and whether they are the rivers' final detail.
