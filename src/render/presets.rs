@@ -25,8 +25,12 @@ pub enum Preset {
     Ground,
 }
 
-/// The radius of Appendix A's planet, for which the presets' distances were chosen.
+/// Appendix A's planet, for which the presets' distances were chosen: its radius (the orbit and the mountains,
+/// a range seen whole, scale with a planet's radius) and its widest river (the river view scales with a planet's
+/// rivers). Earth's rivers are a 32,000th of its radius, Appendix A's a 200th: a river view at the radius's scale
+/// looked at an Earth river from 155 km up, and saw none.
 const APPENDIX_A_RADIUS: f64 = 1024.0;
+const APPENDIX_A_WIDEST_RIVER: f64 = 5.0;
 
 /// The beaches' share of the relief above sea level: the river presets look at rivers above them.
 const BEACH: f32 = 0.05;
@@ -40,9 +44,12 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
     let r = world.planet.radius;
     let up = |d: DVec3| d.normalize();
     let height = |d: DVec3| world.planet.height_at(d) as f64;
-    // Distances were chosen on Appendix A's planet (radius 1024) and scale with the radius.
-    let unit = r / APPENDIX_A_RADIUS;
     let sea = world.planet.sea_level as f64;
+    // Distances in Appendix A's world units, and the world units they stand for on this planet.
+    let unit = r / APPENDIX_A_RADIUS;
+    let river = &world.config.river;
+    let river_unit =
+        (river.starting_width * river.ending_factor.max(1.0)) as f64 / APPENDIX_A_WIDEST_RIVER;
     Some(match preset {
         Preset::Orbit => {
             let d = up(system.source + DVec3::Y * 0.25);
@@ -58,16 +65,25 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             )
         }
         Preset::River => {
-            let segment = lower_course(world, system);
+            // The river as drawn at the scale of the view: pieces no longer than the look ahead.
+            let ahead = 40.0 * river_unit;
+            let coarse = lower_course(world, system);
+            let segment = finest_piece_near(
+                coarse,
+                coarse.curve.point(0.5),
+                ahead,
+                &world.network.params,
+            );
             let middle = segment.curve.point(0.5);
             let target = system.frame.to_sphere(middle);
             let along = system
                 .frame
-                .to_sphere(middle + segment.curve.derivative(0.5).normalize() * 40.0 * unit);
+                .to_sphere(middle + segment.curve.derivative(0.5).normalize() * ahead);
             let back = (target - along).normalize();
-            let eye_dir = up(target + back * 0.03);
+            // 0.03 radians of Appendix A's planet, at this planet's river scale.
+            let eye_dir = up(target + back * 0.03 * APPENDIX_A_RADIUS * river_unit / r);
             (
-                eye_dir * (r + height(eye_dir).max(sea) + 25.0 * unit),
+                eye_dir * (r + height(eye_dir).max(sea) + 25.0 * river_unit),
                 target * (r + height(target)),
             )
         }
