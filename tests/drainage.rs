@@ -311,6 +311,21 @@ fn finer_levels_draw_their_own_streams_from_their_level_on() {
         level.reaches >= base.reaches.len(),
         "a level adds at least as many reaches as the base network has"
     );
+    // The network as drawn: the base network's orders where no stream joins, one order more with the streams
+    // (docs/geomorphology.md, "The network as drawn").
+    let head = |reach| riverplanet::drainage::streams::Junction { reach, at: 0.0 };
+    let base_outlets: Vec<_> = base
+        .reaches
+        .iter()
+        .map(|r| r.downstream.map(head))
+        .collect();
+    let alone = riverplanet::drainage::drawn::measure(&base_outlets);
+    assert_eq!(alone.strahler_max, base.measures.strahler_max);
+    assert_eq!(alone.bifurcation_ratio, base.measures.bifurcation_ratio);
+    println!("drawn down to level {}: {:?}", level.level, level.drawn);
+    assert_eq!(level.drawn.strahler_max, base.measures.strahler_max + 1);
+    assert!((3.0..=5.0).contains(&level.drawn.bifurcation_ratio));
+    assert!(level.drawn.reaches > base.reaches.len() + level.reaches);
     for system in &level.systems {
         assert!(system.reach > 0.0 && system.reach < config.river.influence_distance);
         for segment in &system.segments {
@@ -333,4 +348,21 @@ fn finer_levels_draw_their_own_streams_from_their_level_on() {
     assert!(!coarse.final_detail);
     let reach = level.systems[0].reach;
     assert!(fine.samples.iter().any(|s| s.reach == reach));
+}
+
+/// config/earth.xml draws two levels of streams: the network a user sees descending spans six Strahler orders, with
+/// Horton's ratio of real networks (3-5), where its base lattice shows four (docs/geomorphology.md, "The network as
+/// drawn").
+#[test]
+fn earths_drawn_network_spans_six_orders() {
+    let config = riverplanet::config::Config::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml"),
+    )
+    .unwrap();
+    assert_eq!(config.river.stream_levels, 2);
+    let world = riverplanet::world::World::build(&config, config.resolve_seed()).unwrap();
+    let deepest = world.network.streams.last().unwrap();
+    println!("drawn down to level {}: {:?}", deepest.level, deepest.drawn);
+    assert!(deepest.drawn.strahler_max >= 6);
+    assert!((3.0..=5.0).contains(&deepest.drawn.bifurcation_ratio));
 }

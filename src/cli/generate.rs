@@ -115,7 +115,14 @@ pub fn generate(
     value["stream_levels"] = network
         .streams
         .iter()
-        .map(|l| serde_json::json!({ "level": l.level, "reaches": l.reaches, "systems": l.systems.len() }))
+        .map(|l| {
+            serde_json::json!({
+                "level": l.level,
+                "reaches": l.reaches,
+                "systems": l.systems.len(),
+                "drawn": l.drawn,
+            })
+        })
         .collect();
     if let Some(drainage) = &planet.drainage {
         // The drainage model's measures, at the top level (docs/rivers.md).

@@ -3,6 +3,7 @@
 //! towards them in valleys. The thesis's rivers (one random walk per mountain, Chapter 5) stay selectable as
 //! `<river-model>thesis</river-model>`.
 
+pub mod drawn;
 pub mod finer;
 pub mod grid;
 pub mod meanders;

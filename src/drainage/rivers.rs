@@ -125,28 +125,21 @@ pub fn extract(
             downstream: None,
         });
     }
-    // Links and Strahler orders, upstream first.
-    let mut incoming: Vec<Vec<u32>> = vec![Vec::new(); reaches.len()];
-    for (r, reach) in reaches.iter_mut().enumerate() {
+    // Links and Strahler orders.
+    for reach in reaches.iter_mut() {
         let end = *reach.nodes.last().unwrap() as usize;
         let below = starting_at[end];
         if below != u32::MAX && river[end] {
             reach.downstream = Some(below as usize);
-            incoming[below as usize].push(r as u32);
         }
     }
-    for r in 0..reaches.len() {
-        let orders: Vec<u32> = incoming[r]
-            .iter()
-            .map(|&u| reaches[u as usize].strahler)
-            .collect();
-        if let Some(&top) = orders.iter().max() {
-            let ties = orders.iter().filter(|&&o| o == top).count();
-            reaches[r].strahler = if ties >= 2 { top + 1 } else { top };
-        }
+    let downstream: Vec<Option<usize>> = reaches.iter().map(|r| r.downstream).collect();
+    let ordering = order(&downstream);
+    for (reach, &strahler) in reaches.iter_mut().zip(&ordering.strahler) {
+        reach.strahler = strahler;
     }
     let measures = measure(
-        grid, routing, heights, sea_level, &reaches, &incoming, &river, &lake_of,
+        grid, routing, heights, sea_level, &reaches, &ordering, &river, &lake_of,
     );
     DrainageNetwork {
         measures: DrainageMeasures {
@@ -259,52 +252,11 @@ fn measure(
     heights: &[f64],
     sea_level: f64,
     reaches: &[Reach],
-    incoming: &[Vec<u32>],
+    ordering: &Ordering,
     river: &[bool],
     lake_of: &[Option<u32>],
 ) -> DrainageMeasures {
     let n = grid.len();
-    // Horton: a stream of order w starts where a reach of order w has no incoming reach of order w. Counted in
-    // the basins whose outlet has order HORTON_BASIN_ORDER or more (all basins if none has): Horton's law
-    // describes branched networks, and a coast's first- and second-order creeks have no branching to measure.
-    let strahler_max = reaches.iter().map(|r| r.strahler).max().unwrap_or(0);
-    let outlet_order = |mut r: usize| {
-        while let Some(d) = reaches[r].downstream {
-            r = d;
-        }
-        reaches[r].strahler
-    };
-    let basin_order = HORTON_BASIN_ORDER.min(strahler_max);
-    let outlet = |mut r: usize| {
-        while let Some(d) = reaches[r].downstream {
-            r = d;
-        }
-        r
-    };
-    let mut streams = vec![0usize; strahler_max as usize + 1];
-    // Streams per order in each basin (by its outlet reach).
-    let mut per_basin: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
-    for (r, reach) in reaches.iter().enumerate() {
-        let starts = !incoming[r]
-            .iter()
-            .any(|&u| reaches[u as usize].strahler == reach.strahler);
-        if starts && outlet_order(r) >= basin_order {
-            streams[reach.strahler as usize] += 1;
-            let basin = per_basin
-                .entry(outlet(r))
-                .or_insert_with(|| vec![0; strahler_max as usize + 1]);
-            basin[reach.strahler as usize] += 1;
-        }
-    }
-    let horton: Vec<Vec<(f64, f64)>> = per_basin
-        .values()
-        .map(|counts| {
-            (1..=strahler_max)
-                .filter(|&w| counts[w as usize] > 0)
-                .map(|w| (w as f64, (counts[w as usize] as f64).ln()))
-                .collect()
-        })
-        .collect();
     // Hack: the longest flow path above each node (to the divide), upstream first.
     let mut longest = vec![0.0f64; n];
     for &k in &routing.upstream_first {
@@ -356,12 +308,94 @@ fn measure(
         reaches: reaches.len(),
         confluences: 0,
         lakes: 0,
-        strahler_max,
-        streams_per_order: streams[1..].to_vec(),
-        bifurcation_ratio: (-within_basin_slope(&horton)).exp(),
+        strahler_max: ordering.strahler_max,
+        streams_per_order: ordering.streams_per_order.clone(),
+        bifurcation_ratio: ordering.bifurcation_ratio,
         hack_exponent: slope(&hack),
         drained_land_fraction: if land > 0.0 { drained_land / land } else { 0.0 },
         uphill_steps,
         crossings,
+    }
+}
+
+/// Strahler orders and Horton's stream counts of a forest of reaches.
+#[derive(Clone, Debug, Default)]
+pub struct Ordering {
+    /// Per reach: 1 from a head, the larger of the joining orders below a confluence, plus one when two of the
+    /// largest meet.
+    pub strahler: Vec<u32>,
+    pub strahler_max: u32,
+    /// Strahler streams of each order (index 0: order 1) in the basins of order [`HORTON_BASIN_ORDER`] and more.
+    pub streams_per_order: Vec<usize>,
+    /// Horton's bifurcation ratio over those basins ([`DrainageMeasures::bifurcation_ratio`]).
+    pub bifurcation_ratio: f64,
+}
+
+/// Orders the forest whose reach `r` flows into `downstream[r]` (in any order; every link leads to a mouth). Horton:
+/// a stream of order w starts where a reach of order w has no incoming reach of order w; streams are counted in the
+/// basins whose outlet has order [`HORTON_BASIN_ORDER`] or more (all basins if none has): Horton's law describes
+/// branched networks, and a coast's first- and second-order creeks have no branching to measure.
+pub fn order(downstream: &[Option<usize>]) -> Ordering {
+    let n = downstream.len();
+    let mut incoming: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (r, d) in downstream.iter().enumerate() {
+        if let Some(d) = *d {
+            incoming[d].push(r);
+        }
+    }
+    // Upstream first: a reach once every reach that joins it is ordered.
+    let mut waiting: Vec<usize> = incoming.iter().map(Vec::len).collect();
+    let mut ready: Vec<usize> = (0..n).filter(|&r| waiting[r] == 0).collect();
+    let mut upstream_first = Vec::with_capacity(n);
+    let mut strahler = vec![1u32; n];
+    while let Some(r) = ready.pop() {
+        upstream_first.push(r);
+        if let Some(top) = incoming[r].iter().map(|&u| strahler[u]).max() {
+            let ties = incoming[r].iter().filter(|&&u| strahler[u] == top).count();
+            strahler[r] = if ties >= 2 { top + 1 } else { top };
+        }
+        if let Some(d) = downstream[r] {
+            waiting[d] -= 1;
+            if waiting[d] == 0 {
+                ready.push(d);
+            }
+        }
+    }
+    debug_assert_eq!(upstream_first.len(), n, "the reaches' links form a cycle");
+    let mut outlet: Vec<usize> = (0..n).collect();
+    for &r in upstream_first.iter().rev() {
+        if let Some(d) = downstream[r] {
+            outlet[r] = outlet[d];
+        }
+    }
+    let strahler_max = strahler.iter().copied().max().unwrap_or(0);
+    let basin_order = HORTON_BASIN_ORDER.min(strahler_max);
+    let mut streams = vec![0usize; strahler_max as usize + 1];
+    // Streams per order in each basin (by its outlet reach).
+    let mut per_basin: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for r in 0..n {
+        let starts = !incoming[r].iter().any(|&u| strahler[u] == strahler[r]);
+        if starts && strahler[outlet[r]] >= basin_order {
+            streams[strahler[r] as usize] += 1;
+            let basin = per_basin
+                .entry(outlet[r])
+                .or_insert_with(|| vec![0; strahler_max as usize + 1]);
+            basin[strahler[r] as usize] += 1;
+        }
+    }
+    let horton: Vec<Vec<(f64, f64)>> = per_basin
+        .values()
+        .map(|counts| {
+            (1..=strahler_max)
+                .filter(|&w| counts[w as usize] > 0)
+                .map(|w| (w as f64, (counts[w as usize] as f64).ln()))
+                .collect()
+        })
+        .collect();
+    Ordering {
+        strahler,
+        strahler_max,
+        streams_per_order: streams.get(1..).unwrap_or_default().to_vec(),
+        bifurcation_ratio: (-within_basin_slope(&horton)).exp(),
     }
 }

@@ -57,6 +57,17 @@ pub struct Course {
     /// Half the river's width (radians; 0 for a lake).
     pub half_width: f64,
     pub lake: bool,
+    /// Where on the reaches added this point lies (none on a lake).
+    pub junction: Option<Junction>,
+}
+
+/// A place on a drawn reach where a stream joins it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Junction {
+    /// The reach: its index among those [`Courses::add_reaches`] was given.
+    pub reach: usize,
+    /// The position along it: its point index, with the share of the way to the next point.
+    pub at: f64,
 }
 
 impl Courses {
@@ -85,7 +96,7 @@ impl Courses {
         step: f64,
         half_width: impl Fn(f64) -> f64,
     ) {
-        for reach in reaches {
+        for (r, reach) in reaches.iter().enumerate() {
             for i in 0..reach.points.len() {
                 let j = (i + 1).min(reach.points.len() - 1);
                 let (a, b) = (reach.points[i], reach.points[j]);
@@ -102,6 +113,10 @@ impl Courses {
                         height: reach.beds[i] + (reach.beds[j] - reach.beds[i]) * t as f32,
                         half_width: half_width(area),
                         lake: false,
+                        junction: Some(Junction {
+                            reach: r,
+                            at: i as f64 + t,
+                        }),
                     });
                 }
             }
@@ -117,6 +132,7 @@ impl Courses {
                     height: lake.level,
                     half_width: 0.0,
                     lake: true,
+                    junction: None,
                 });
             }
         }
@@ -181,8 +197,12 @@ const STRAYED_AREA_FACTOR: f64 = 2.0;
 
 /// The new streams of `finer` (a network routed at a finer level) against the `drawn` courses: reaches in flow
 /// order, each ending where it joins a drawn course, in the sea, or in the reach below (`downstream`, an index
-/// into the result).
-pub fn new_streams(finer: &[ReachPath], drawn: &Courses, rule: &StreamRule) -> Vec<ReachPath> {
+/// into the result); and for each, where it joins a drawn river (none where it flows on, into the sea or a lake).
+pub fn new_streams(
+    finer: &[ReachPath],
+    drawn: &Courses,
+    rule: &StreamRule,
+) -> (Vec<ReachPath>, Vec<Option<Junction>>) {
     let fates: Vec<Fate> = finer.iter().map(|reach| fate(reach, drawn, rule)).collect();
     // A reach is drawn if it joins a course with something of its own, or flows into the sea or into a drawn reach.
     let mut kept: Vec<Option<bool>> = vec![None; finer.len()];
@@ -215,11 +235,20 @@ pub fn new_streams(finer: &[ReachPath], drawn: &Courses, rule: &StreamRule) -> V
             next += 1;
         }
     }
-    finer
-        .iter()
-        .zip(&fates)
-        .enumerate()
-        .filter(|(k, _)| index[*k] != usize::MAX)
+    let kept = || {
+        finer
+            .iter()
+            .zip(&fates)
+            .enumerate()
+            .filter(|(k, _)| index[*k] != usize::MAX)
+    };
+    let joins = kept()
+        .map(|(_, (_, fate))| match fate {
+            Fate::Joins { course, .. } => course.junction,
+            _ => None,
+        })
+        .collect();
+    let streams = kept()
         .map(|(_, (reach, fate))| match *fate {
             Fate::Joins { at, course } if course.lake => ReachPath {
                 // At the shore: the lake is drawn wherever the ground lies below its level (docs/kernel.md).
@@ -255,7 +284,8 @@ pub fn new_streams(finer: &[ReachPath], drawn: &Courses, rule: &StreamRule) -> V
                 ..reach.clone()
             },
         })
-        .collect()
+        .collect();
+    (streams, joins)
 }
 
 /// Lays the beds of `streams` (in flow order, upstream reaches first, as [`new_streams`] gives them) no higher

@@ -15,8 +15,8 @@ use super::{
 use crate::{
     config::Config,
     drainage::{
-        finer, meander_reaches,
-        streams::{lay_beds, new_streams, Courses, StreamRule},
+        drawn, finer, meander_reaches,
+        streams::{lay_beds, new_streams, Courses, Junction, StreamRule},
         Drainage, LakeShape, ReachPath,
     },
     planet::{cube::PatchId, height_on, Planet},
@@ -229,6 +229,9 @@ pub fn stream_levels(
             * 2f64.powi(planet.precomputed_level as i32 - level as i32)
     };
     let mut drawn: Vec<ReachPath> = drainage.reaches.clone();
+    // Where each drawn reach flows out: the head of the reach below, or where it joins a coarser course.
+    let head = |reach: usize| Junction { reach, at: 0.0 };
+    let mut outlets: Vec<Option<Junction>> = drawn.iter().map(|r| r.downstream.map(head)).collect();
     let mut levels = Vec::new();
     let mut next_id = first_id;
     for level in base + 1..=base + config.river.stream_levels {
@@ -248,8 +251,9 @@ pub fn stream_levels(
             0.5 * reach_width(config, drainage, area) as f64 / planet.radius
         });
         courses.add_lakes(&drainage.lakes);
+        let (streams, joins) = new_streams(&finer.reaches, &courses, &rule);
         let mut streams = meander_reaches(
-            &new_streams(&finer.reaches, &courses, &rule),
+            &streams,
             ground.cells,
             &config.planet,
             &config.river,
@@ -282,11 +286,20 @@ pub fn stream_levels(
             streams.len(),
             systems.len()
         );
+        let first = drawn.len();
+        outlets.extend(
+            streams
+                .iter()
+                .zip(joins)
+                .map(|(reach, join)| join.or(reach.downstream.map(|d| head(first + d)))),
+        );
+        let ms = since.elapsed().as_secs_f64() * 1e3;
         levels.push(StreamLevel {
             level,
             reaches: streams.len(),
             systems,
-            ms: since.elapsed().as_secs_f64() * 1e3,
+            ms,
+            drawn: drawn::measure(&outlets),
         });
         drawn.extend(streams);
     }

@@ -320,6 +320,8 @@ pub struct StreamLevel {
     pub reaches: usize,
     /// Time taken to route the level and choose its streams, milliseconds.
     pub ms: f64,
+    /// The network drawn down to this level: the base rivers and every level's streams up to this one.
+    pub drawn: crate::drainage::drawn::DrawnMeasures,
 }
 
 /// All river systems of a planet.
