@@ -40,9 +40,12 @@ float periodicNoise(vec3 x, float period) {
 }
 
 // Beyond the thesis (terrain close up): detail below the vertex spacing, three octaves of value noise from one
-// world unit down to 1/16, each fading out while its cells shrink from about four pixels to two (smaller cells
-// alias: they sparkle as the camera moves), so the ground keeps detail at a few units (metres on
-// config/earth.xml) and a distant fragment computes none. In [0, 1], 0.5 where nothing shows.
+// world unit down to 1/16, each fading out while its cells shrink from about three pixels to one and a half
+// (smaller cells alias: they sparkle as the camera moves), so the ground keeps detail at a few units (metres on
+// config/earth.xml). Where even the unit octave is that small (Earth's ground from tens of metres up and higher),
+// coarser octaves of 4, 16 and 64 units take over, each fading out again once its cells pass 128 pixels: without
+// them a planet in metres showed one flat colour from a kilometre up. A view that resolves the unit octave looks
+// as it did. In [0, 1], 0.5 where nothing shows.
 // Coordinates: fDetail, the world position modulo DETAIL_PERIOD (precise near the camera at any planet size).
 float groundDetail() {
     // About 1.4 to 2 pixels' size on the surface.
@@ -50,15 +53,19 @@ float groundDetail() {
     float sum = 0.0;
     float amplitude = 1.0;
     float size = 1.0;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 3; ++k, amplitude *= 0.6, size *= 0.25) {
         float fade = 1.0 - smoothBand(0.35, 0.7, footprint / size);
         if (fade <= 0.0) break;
         sum += amplitude * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
-        amplitude *= 0.6;
-        size *= 0.25;
     }
-    // The three amplitudes add up to 1.96.
-    return 0.5 + sum / 1.4;
+    float coarse = smoothBand(0.35, 0.7, footprint);
+    size = 4.0;
+    for (int k = 0; k < 3 && coarse > 0.0; ++k, size *= 4.0) {
+        float pixels = size / max(footprint, 1e-6);
+        float fade = coarse * (1.0 - smoothBand(0.35, 0.7, 1.0 / pixels)) * (1.0 - smoothBand(128.0, 1024.0, pixels));
+        sum += 0.4 * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
+    }
+    return clamp(0.5 + sum / 1.4, 0.0, 1.0);
 }
 
 // Fig. 8.2: weights of the textures by height, with linear transitions; heights in units of frame.extra.z, so
