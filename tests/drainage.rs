@@ -288,8 +288,8 @@ fn finer_levels_draw_their_own_streams_from_their_level_on() {
     use riverplanet::{
         planet::cube::PatchId,
         river::{
-            network::MAX_GENERATION,
             samples::{patch_samples, PatchFrame},
+            system::MAX_GENERATION,
         },
     };
     let mut config = drainage_config();

@@ -8,8 +8,9 @@ use riverplanet::{
     planet::{cube::PatchId, Planet},
     river::{
         hull,
-        network::{hulls_meet, pieces_to_depth, subdivide, RiverNetwork},
+        network::RiverNetwork,
         samples::{influences, patch_samples, piece_samples, PatchFrame},
+        system::{hulls_meet, pieces_to_depth, subdivide},
     },
 };
 
@@ -115,7 +116,7 @@ fn tributary_angles_stay_within_22_to_45_degrees() {
     assert!(seen > 0);
 }
 
-fn curve_points(piece: &riverplanet::river::network::Segment) -> Vec<DVec2> {
+fn curve_points(piece: &riverplanet::river::system::Segment) -> Vec<DVec2> {
     (0..=32)
         .map(|k| piece.curve.point(k as f64 / 32.0))
         .collect()

@@ -5,8 +5,9 @@
 use ash::vk;
 
 use super::{
-    context::{create_instance, load_entry, ContextOptions},
-    features, FeatureReport, GpuError, VkResultExt,
+    features,
+    instance::{create_instance, load_entry, ContextOptions},
+    FeatureReport, GpuError, VkResultExt,
 };
 
 /// What `riverplanet info` shows of one physical device.

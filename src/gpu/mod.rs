@@ -1,7 +1,8 @@
 //! The Vulkan backend: the only module that imports `ash`. It knows nothing of planets.
 //!
 //! One file per concern, as in wgpu-hal: [`access`] (the synchronisation vocabulary: every barrier names uses, not
-//! stage and access flags), [`adapter`] (describing the devices and choosing one), [`context`] (instance, device, queue, allocator), `debug` (validation messages, object names, labels),
+//! stage and access flags), [`instance`] (the loader, the instance and the options a context is made with), [`adapter`] (describing the
+//! devices and choosing one), [`context`] (device, queue, allocator), `debug` (validation messages, object names, labels),
 //! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
 //! [`commands`] (everything recorded into a command buffer: uploads, copies, barriers, dispatches, draws), [`submit`]
 //! (command buffers, timeline-semaphore submissions), [`frames`] (the ring of
@@ -17,6 +18,7 @@ pub mod context;
 mod debug;
 pub mod features;
 pub mod frames;
+pub mod instance;
 pub mod memory;
 pub mod overlay;
 pub mod pipeline;
@@ -32,8 +34,9 @@ pub use ash::vk;
 pub use ash::vk::{
     DescriptorSet, DescriptorSetLayout, DrawIndexedIndirectCommand, Extent2D, Format, Semaphore,
 };
-pub use context::{Context, ContextOptions};
+pub use context::Context;
 pub use features::FeatureReport;
+pub use instance::ContextOptions;
 pub use memory::{Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};
 pub use profiler::{Profiler, ScopeTiming};
 pub use submit::{Recorder, SubmissionId};

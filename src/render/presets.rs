@@ -5,8 +5,8 @@ use glam::DVec3;
 
 use crate::{
     river::{
-        network::{finest_piece_near, RiverSystem, Segment},
         samples::sample_step,
+        system::{finest_piece_near, RiverSystem, Segment},
     },
     world::World,
 };

@@ -6,11 +6,11 @@
 use glam::{DVec2, DVec3};
 
 use super::{
-    network::{
+    spline::Hermite,
+    system::{
         enclose, RiverFrame, RiverSystem, Segment, StreamLevel, SubdivisionParams, MAX_DEPTH,
         MAX_GENERATION,
     },
-    spline::Hermite,
 };
 use crate::{
     config::Config,

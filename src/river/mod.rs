@@ -5,3 +5,4 @@ pub mod hull;
 pub mod network;
 pub mod samples;
 pub mod spline;
+pub mod system;

@@ -6,7 +6,8 @@ use glam::{DVec2, DVec3};
 
 use super::{
     hull,
-    network::{subdivide, RiverNetwork, RiverSystem, Segment, MAX_DEPTH},
+    network::RiverNetwork,
+    system::{subdivide, RiverSystem, Segment, MAX_DEPTH},
 };
 use crate::{
     planet::cube::{self, PatchId},
@@ -246,7 +247,7 @@ pub struct Branch {
 
 /// Every branch of a system at `depth`, for drawing and GeoJSON; the main river first.
 pub fn polylines(network: &RiverNetwork, system: &RiverSystem, depth: u32) -> Vec<Branch> {
-    let pieces = super::network::pieces_to_depth(&system.segments, depth, &network.params);
+    let pieces = super::system::pieces_to_depth(&system.segments, depth, &network.params);
     let mut lines: Vec<Branch> = Vec::new();
     for piece in pieces.iter().filter(|p| p.depth == depth) {
         let points = (0..=8).map(|k| system.frame.to_sphere(piece.curve.point(k as f64 / 8.0)));

@@ -1,0 +1,374 @@
+//! The river-system model both generators build (Chapter 5): a system's 2D frame, its Hermite segments with bed
+//! heights and widths (5.1), their subdivision per level of detail with bounded random displacement (5.2.2) and
+//! the tributaries it spawns (5.2.3), and the convex hull and extended hull that enclose a system (3.7, 6.3).
+//! The thesis's random-walk rivers (network.rs) and the drainage model's reaches (drainage.rs) become these.
+//!
+//! Each river system lives in its own 2D frame: the gnomonic projection about the system's centre, scaled by the
+//! radius. Great circles are straight lines there (so patch edges, which are great circles, stay straight) and
+//! distances are world units, exact at the centre and within a few percent over a river.
+
+use glam::{DVec2, DVec3};
+
+use super::{
+    hull,
+    spline::{rotate, Hermite},
+};
+use crate::{
+    config::Config,
+    rng::{self, Rng},
+};
+
+const STREAM_SUBDIVIDE: u64 = 0x52_0002;
+const STREAM_TRIBUTARY: u64 = 0x52_0003;
+/// Tributaries of tributaries at most.
+pub const MAX_GENERATION: u32 = 2;
+/// Deepest subdivision ever made.
+pub const MAX_DEPTH: u32 = 12;
+
+/// A river system's 2D frame (see the module documentation).
+#[derive(Clone, Copy, Debug)]
+pub struct RiverFrame {
+    pub centre: DVec3,
+    pub e1: DVec3,
+    pub e2: DVec3,
+    pub radius: f64,
+}
+
+impl RiverFrame {
+    pub fn new(centre: DVec3, towards: DVec3, radius: f64) -> Self {
+        let e1 = (towards - centre * towards.dot(centre)).normalize();
+        Self {
+            centre,
+            e1,
+            e2: centre.cross(e1),
+            radius,
+        }
+    }
+
+    /// The frame position of a direction; `None` for directions more than ~84 degrees from the centre.
+    pub fn to_plane(&self, d: DVec3) -> Option<DVec2> {
+        let c = d.dot(self.centre);
+        (c > 0.1).then(|| {
+            let q = d / c;
+            DVec2::new(q.dot(self.e1), q.dot(self.e2)) * self.radius
+        })
+    }
+
+    /// The unit direction of a frame position.
+    pub fn to_sphere(&self, p: DVec2) -> DVec3 {
+        (self.centre + (self.e1 * p.x + self.e2 * p.y) / self.radius).normalize()
+    }
+}
+
+/// A piece of a river at some depth of subdivision: its curve in the system's frame, and the river-bed height and
+/// full width at both ends (linear in between, 5.1).
+#[derive(Clone, Copy, Debug)]
+pub struct Segment {
+    pub curve: Hermite,
+    pub heights: (f32, f32),
+    pub widths: (f32, f32),
+    /// Identity of this piece (a hash of its path from the initial segment): all its randomness derives from it.
+    pub key: u64,
+    pub depth: u32,
+    /// 0 for the main river, 1 for its tributaries, 2 for theirs.
+    pub generation: u32,
+    /// Key of the branch (main river or tributary) this piece belongs to, and of the branch it flows into.
+    pub branch: u64,
+    pub parent_branch: Option<u64>,
+    /// A lake's piece (beyond the thesis, docs/rivers.md): its height is the lake's water level, and its samples
+    /// put that level on the vertices within half its width, where the terrain below it is drawn under water.
+    pub lake: bool,
+}
+
+impl Segment {
+    pub fn height_at(&self, t: f64) -> f32 {
+        self.heights.0 + (self.heights.1 - self.heights.0) * t as f32
+    }
+
+    pub fn width_at(&self, t: f64) -> f32 {
+        self.widths.0 + (self.widths.1 - self.widths.0) * t as f32
+    }
+
+    /// Length of the Bézier control polygon (at least the curve's length).
+    /// The smaller of the widths at the two ends.
+    pub fn narrowest(&self) -> f64 {
+        self.widths.0.min(self.widths.1) as f64
+    }
+
+    pub fn polygon_length(&self) -> f64 {
+        let c = self.curve.control_points();
+        c[0].distance(c[1]) + c[1].distance(c[2]) + c[2].distance(c[3])
+    }
+}
+
+/// The parameters of subdivision, from the configuration.
+#[derive(Clone, Copy, Debug)]
+pub struct SubdivisionParams {
+    pub seed: u64,
+    pub pieces: u32,
+    pub displacement: f64,
+    pub tributary_probability: f64,
+    pub min_width: f32,
+}
+
+impl SubdivisionParams {
+    pub fn from_config(config: &Config, seed: u64) -> Self {
+        Self {
+            seed,
+            pieces: config.river.segments.max(2),
+            displacement: config.river.displacement as f64,
+            tributary_probability: config.river.tributary_probability as f64,
+            min_width: config.river.min_width,
+        }
+    }
+
+    /// How far any geometry descending from a piece of control-polygon length `length` (finer pieces and their
+    /// tributaries) can stray from the piece's control polygon: a geometric series over the levels below,
+    /// doubled for safety.
+    pub fn descendant_margin(&self, length: f64) -> f64 {
+        2.0 * length * (self.displacement + 1.3) / (self.pieces as f64 - 1.0)
+    }
+}
+
+/// Section 5.2.2: splits `segment` into `pieces` pieces, moving each inner knot by a random vector of at most
+/// `displacement x length / pieces` and turning its tangent by up to 30 degrees. The ends and their tangents stay,
+/// and neighbouring pieces share knot and tangent, so the river stays C1. Section 5.2.3: with
+/// `tributary-probability`, a tributary joins at a random inner knot. Deterministic per piece: randomness comes
+/// from the piece's key only.
+pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>, Option<Segment>) {
+    let m = params.pieces;
+    let mut rng = Rng::new(params.seed, &[STREAM_SUBDIVIDE, segment.key]);
+    let length = segment.polygon_length();
+    let mut knots: Vec<(DVec2, DVec2)> = (0..=m)
+        .map(|k| {
+            let t = k as f64 / m as f64;
+            (
+                segment.curve.point(t),
+                segment.curve.derivative(t) / m as f64,
+            )
+        })
+        .collect();
+    for knot in knots.iter_mut().take(m as usize).skip(1) {
+        let angle = rng.range_f64(0.0, std::f64::consts::TAU);
+        let distance = rng.range_f64(0.0, params.displacement * length / m as f64);
+        knot.0 += DVec2::new(angle.cos(), angle.sin()) * distance;
+        knot.1 = rotate(knot.1, rng.range_f64(-30.0, 30.0).to_radians());
+    }
+    let children: Vec<Segment> = (0..m as usize)
+        .map(|k| {
+            let (t0, t1) = (k as f64 / m as f64, (k + 1) as f64 / m as f64);
+            Segment {
+                curve: Hermite {
+                    p0: knots[k].0,
+                    d0: knots[k].1,
+                    p1: knots[k + 1].0,
+                    d1: knots[k + 1].1,
+                },
+                heights: (segment.height_at(t0), segment.height_at(t1)),
+                widths: (segment.width_at(t0), segment.width_at(t1)),
+                key: rng::hash(segment.key, &[k as u64]),
+                depth: segment.depth + 1,
+                ..*segment
+            }
+        })
+        .collect();
+
+    let mut trib_rng = Rng::new(params.seed, &[STREAM_TRIBUTARY, segment.key]);
+    let spawn = segment.generation < MAX_GENERATION
+        && trib_rng.unit() < params.tributary_probability as f32;
+    let tributary = spawn.then(|| {
+        // The junction is an inner knot in the downstream half, and the tributary about as long as the segment's
+        // part upstream of it, so it stays beside its own segment instead of reaching the pieces upstream.
+        let k = (m as usize).div_ceil(2) + trib_rng.below(m as u64 / 2) as usize;
+        let k = k.min(m as usize - 1);
+        let (junction, flow) = knots[k];
+        let t = k as f64 / m as f64;
+        let width = segment.width_at(t);
+        let tributary_length = segment.curve.chord() * t * trib_rng.range_f64(0.8, 1.0);
+        let widths = (
+            (width * 0.4).max(params.min_width),
+            (width * 0.6).max(params.min_width),
+        );
+        // Too short for its width: no tributary (it would be a blob, not a river).
+        if tributary_length < 8.0 * widths.1 as f64 {
+            return None;
+        }
+        // The tributary must meet its parent only at the junction: try a few angles and sides, keep the first
+        // that stays clear of the (already displaced) parent pieces, or spawn none.
+        let parent_points: Vec<DVec2> = children
+            .iter()
+            .flat_map(|c| (0..=16).map(move |s| c.curve.point(s as f64 / 16.0)))
+            .collect();
+        let clearance = 0.5 * (width + widths.1) as f64;
+        let back = -flow.normalize();
+        let start = (0..4).find_map(|_| {
+            let sign = if trib_rng.unit() < 0.5 { -1.0 } else { 1.0 };
+            let angle = sign * trib_rng.range_f64(22.0, 45.0).to_radians();
+            let start = junction + rotate(back, angle) * tributary_length;
+            let curve = Hermite {
+                p0: start,
+                d0: junction - start,
+                p1: junction,
+                d1: flow.normalize() * tributary_length,
+            };
+            let clear = (0..=24).all(|s| {
+                let p = curve.point(s as f64 / 32.0);
+                parent_points.iter().all(|q| q.distance(p) > clearance)
+            });
+            clear.then_some(start)
+        })?;
+        let height_end = segment.height_at(t);
+        let slope = (segment.heights.0 - segment.heights.1).max(0.0)
+            / segment.curve.chord().max(1e-9) as f32;
+        let key = rng::hash(segment.key, &[0x7472_6962]);
+        Some(Segment {
+            curve: Hermite {
+                p0: start,
+                d0: (junction - start),
+                p1: junction,
+                d1: flow.normalize() * tributary_length,
+            },
+            heights: (height_end + slope * tributary_length as f32, height_end),
+            widths,
+            key,
+            depth: segment.depth + 1,
+            generation: segment.generation + 1,
+            branch: key,
+            parent_branch: Some(segment.branch),
+            lake: false,
+        })
+    });
+    (children, tributary.flatten())
+}
+
+/// A river from a mountain to the sea with all its tributaries.
+#[derive(Clone, Debug)]
+pub struct RiverSystem {
+    pub id: u32,
+    pub frame: RiverFrame,
+    /// The initial segments (5.2.1), depth 0.
+    pub segments: Vec<Segment>,
+    /// Convex hull of every control point of the system down to `hull-levels`, tributaries included (5.2.3).
+    pub hull: Vec<DVec2>,
+    /// The hull grown by the influence distance and by how far deeper levels can stray (6.3).
+    pub extended: Vec<DVec2>,
+    pub source: DVec3,
+    pub mouth: DVec3,
+    /// Angular radius around `frame.centre` that contains the extended hull.
+    pub cap_angle: f64,
+    /// Beyond the thesis: the influence distance of its samples (0: `influence-distance`, as the thesis).
+    pub reach: f32,
+}
+
+/// Every piece of a river system down to `depth`, tributaries included, in a deterministic order.
+pub fn pieces_to_depth(
+    segments: &[Segment],
+    depth: u32,
+    params: &SubdivisionParams,
+) -> Vec<Segment> {
+    let mut out = Vec::new();
+    let mut stack: Vec<Segment> = segments.iter().rev().copied().collect();
+    while let Some(s) = stack.pop() {
+        out.push(s);
+        if s.depth < depth {
+            let (children, tributary) = subdivide(&s, params);
+            if let Some(t) = tributary {
+                stack.push(t);
+            }
+            stack.extend(children.into_iter().rev());
+        }
+    }
+    out
+}
+
+/// The finest piece of `segment`'s own branch near `point` (a frame position), subdivided until it is at most
+/// `length` long (or [`MAX_DEPTH`] deep): the river as patches of the deepest levels draw it, which meanders away
+/// from the coarse curve by the displacements of every subdivision. Descends one child at a time.
+pub fn finest_piece_near(
+    segment: &Segment,
+    point: DVec2,
+    length: f64,
+    params: &SubdivisionParams,
+) -> Segment {
+    let mut piece = *segment;
+    while piece.depth < MAX_DEPTH && piece.polygon_length() > length {
+        let (children, _) = subdivide(&piece, params);
+        let distance = |s: &Segment| {
+            (0..=8)
+                .map(|k| s.curve.point(k as f64 / 8.0).distance(point))
+                .fold(f64::MAX, f64::min)
+        };
+        piece = children
+            .into_iter()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+            .unwrap_or(piece);
+    }
+    piece
+}
+
+/// The streams one finer level adds, as river systems.
+#[derive(Clone, Debug)]
+pub struct StreamLevel {
+    /// The patch level from which they are drawn.
+    pub level: u32,
+    pub systems: Vec<RiverSystem>,
+    /// Reaches (from a head or confluence to the next confluence, course or the sea).
+    pub reaches: usize,
+    /// Time taken to route the level and choose its streams, milliseconds.
+    pub ms: f64,
+    /// The network drawn down to this level: the base rivers and every level's streams up to this one.
+    pub drawn: crate::drainage::drawn::DrawnMeasures,
+}
+
+/// A system of `segments` in `frame`: its hull over `hull_levels` levels of subdivision, tributaries included
+/// (5.2.3), and the hull extended by the influence distance and by how far deeper levels can stray (6.3).
+pub fn enclose(
+    config: &Config,
+    params: &SubdivisionParams,
+    (id, hull_levels): (u32, u32),
+    frame: RiverFrame,
+    segments: Vec<Segment>,
+    (source, mouth): (DVec3, DVec3),
+) -> RiverSystem {
+    let r = &config.river;
+    let pieces = pieces_to_depth(&segments, hull_levels, params);
+    let points: Vec<DVec2> = pieces
+        .iter()
+        .flat_map(|p| p.curve.control_points())
+        .collect();
+    let hull = hull::convex_hull(&points);
+    let margin = pieces
+        .iter()
+        .filter(|p| p.depth == hull_levels)
+        .map(|p| params.descendant_margin(p.polygon_length()) + p.widths.0.max(p.widths.1) as f64)
+        .fold(0.0, f64::max);
+    let extended = hull::extend(&hull, r.influence_distance as f64 + margin);
+    let cap_angle = extended
+        .iter()
+        .map(|p| frame.to_sphere(*p).angle_between(frame.centre))
+        .fold(0.0, f64::max);
+    RiverSystem {
+        id,
+        frame,
+        segments,
+        hull,
+        extended,
+        source,
+        mouth,
+        cap_angle,
+        reach: 0.0,
+    }
+}
+
+/// Whether two systems' convex hulls overlap (5.2.1), compared in the first system's frame.
+pub fn hulls_meet(a: &RiverSystem, b: &RiverSystem) -> bool {
+    if a.frame.centre.angle_between(b.frame.centre) > a.cap_angle + b.cap_angle {
+        return false;
+    }
+    let other: Option<Vec<DVec2>> = b
+        .hull
+        .iter()
+        .map(|p| a.frame.to_plane(b.frame.to_sphere(*p)))
+        .collect();
+    other.is_none_or(|o| hull::intersects(&a.hull, &o))
+}
