@@ -5,7 +5,7 @@ mod common;
 use riverplanet::{
     gpu::{
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
-        vk, Access, BufferDesc, ImageDesc, ImageUse, MemoryLocation, Profiler,
+        Access, BufferDesc, Extent2D, Format, ImageDesc, ImageUse, MemoryLocation, Profiler,
     },
     shaders,
 };
@@ -146,12 +146,12 @@ fn dropped_buffers_and_images_are_freed_once_the_gpu_is_done() {
     let image = ctx
         .create_image(&ImageDesc {
             name: "dropped image",
-            extent: vk::Extent2D {
+            extent: Extent2D {
                 width: 64,
                 height: 64,
             },
             layers: 1,
-            format: vk::Format::R32_SFLOAT,
+            format: Format::R32_SFLOAT,
             uses: &[Access::GraphicsSampled, Access::TransferWrite],
             array: false,
         })

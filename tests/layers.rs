@@ -131,3 +131,137 @@ fn a_name_is_found_only_as_a_whole_path_segment() {
     ));
     assert!(!names("let m = mvk::x;", "vk::"));
 }
+
+/// The first names of the items of `super::` paths in `code`: `super::a::x` gives `a`, `super::{a, b::y}` gives
+/// `a` and `b`.
+fn super_names(code: &str) -> Vec<String> {
+    let ident = |s: &str| -> String {
+        s.trim_start()
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut out = Vec::new();
+    for (at, _) in code.match_indices("super::") {
+        let rest = &code[at + "super::".len()..];
+        if let Some(block) = rest.strip_prefix('{') {
+            let mut depth = 0;
+            let mut start = 0;
+            for (i, c) in block.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        out.push(ident(&block[start..i]));
+                        break;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        out.push(ident(&block[start..i]));
+                        start = i + 1;
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            out.push(ident(rest));
+        }
+    }
+    out
+}
+
+/// Pairs of files in one module directory below src/ that name each other through `super::` (outside comments and
+/// test modules): a circle means the two concerns are not split where the files say.
+fn sibling_circles() -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    sources(&root, &mut files);
+    let mut uses: std::collections::BTreeMap<(PathBuf, String), Vec<String>> = Default::default();
+    for path in &files {
+        let dir = path.parent().unwrap().to_path_buf();
+        let stem = path.file_stem().unwrap().to_string_lossy().to_string();
+        if dir == root || stem == "mod" {
+            continue;
+        }
+        let text = std::fs::read_to_string(path).unwrap();
+        let code: String = text
+            .split("#[cfg(test)]")
+            .next()
+            .unwrap()
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        uses.insert((dir, stem), super_names(&code));
+    }
+    let mut circles = Vec::new();
+    for ((dir, a), named) in &uses {
+        for b in named.iter().filter(|b| a < *b) {
+            if uses
+                .get(&(dir.clone(), b.clone()))
+                .is_some_and(|back| back.contains(a))
+            {
+                let dir = dir.strip_prefix(&root).unwrap().display();
+                circles.push(format!("src/{dir}/{a}.rs <-> src/{dir}/{b}.rs"));
+            }
+        }
+    }
+    circles.sort();
+    circles.dedup();
+    circles
+}
+
+#[test]
+fn no_two_files_of_a_module_import_each_other() {
+    assert_eq!(
+        super_names("use super::{access, memory::{Buffer, Image}, GpuError};\nlet x = super::drainage::f();"),
+        ["access", "memory", "GpuError", "drainage"]
+    );
+    let circles = sibling_circles();
+    assert!(
+        circles.is_empty(),
+        "import circles:\n{}",
+        circles.join("\n")
+    );
+}
+
+#[test]
+fn the_gpu_module_exposes_no_raw_handle() {
+    let handles = [
+        "vk::Image,",
+        "vk::ImageView,",
+        "vk::Buffer,",
+        "vk::Pipeline,",
+        "vk::PipelineLayout,",
+        "vk::CommandBuffer,",
+        "vk::SwapchainKHR,",
+        "vk::SurfaceKHR,",
+        "vk::PhysicalDevice,",
+        "ash::Device,",
+        "ash::Instance,",
+        "ash::Entry,",
+        "Vec<vk::Image>,",
+        "Vec<vk::ImageView>,",
+    ];
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    sources(&root.join("src/gpu"), &mut files);
+    let mut found = Vec::new();
+    for path in &files {
+        let text = std::fs::read_to_string(path).unwrap();
+        for (n, line) in text.lines().enumerate() {
+            let line = line.trim();
+            let public_field = line.starts_with("pub ")
+                && line
+                    .split_once(':')
+                    .is_some_and(|(_, ty)| handles.contains(&ty.trim()));
+            if public_field || line == "pub use ash::vk;" {
+                found.push(format!("{}:{}: {line}", path.display(), n + 1));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "public raw handles in src/gpu (keep them pub(super)):\n{}",
+        found.join("\n")
+    );
+}

@@ -6,7 +6,7 @@ use ash::vk;
 
 use super::{
     access::{self, Access, ImageUse},
-    pipeline::{ComputePipeline, GraphicsPipeline, RenderTarget},
+    pipeline::{Attachment, ComputePipeline, GraphicsPipeline, RenderTarget},
     Buffer, BufferDesc, GpuError, Image, MemoryLocation, Recorder,
 };
 
@@ -137,15 +137,20 @@ impl Recorder<'_> {
         }
     }
 
-    /// A barrier of an attachment that is not one of our [`Image`]s (a swapchain image, or a render target's
-    /// image), a depth attachment if `depth`, for `usage`.
-    pub fn attachment_barrier(&mut self, image: vk::Image, depth: bool, usage: ImageUse) {
+    /// A barrier of one of `target`'s attachments (whose colour image may be a swapchain's, not one of our
+    /// [`Image`]s), for `usage`.
+    pub fn attachment_barrier(
+        &mut self,
+        target: &RenderTarget,
+        which: Attachment,
+        usage: ImageUse,
+    ) {
+        let (image, aspect) = match which {
+            Attachment::Color => (target.color_image, vk::ImageAspectFlags::COLOR),
+            Attachment::Depth => (target.depth_image, vk::ImageAspectFlags::DEPTH),
+        };
         let range = vk::ImageSubresourceRange::default()
-            .aspect_mask(if depth {
-                vk::ImageAspectFlags::DEPTH
-            } else {
-                vk::ImageAspectFlags::COLOR
-            })
+            .aspect_mask(aspect)
             .level_count(1)
             .layer_count(1);
         let barrier = [access::image_barrier(image, range, false, &usage)];

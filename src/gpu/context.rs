@@ -18,13 +18,13 @@ use super::{
 
 /// The device and everything needed to use it. Shared by reference; internally synchronised.
 pub struct Context {
-    pub(crate) entry: ash::Entry,
-    pub instance: ash::Instance,
+    pub(super) entry: ash::Entry,
+    pub(super) instance: ash::Instance,
     debug_instance: Option<ext::debug_utils::Instance>,
     messenger: vk::DebugUtilsMessengerEXT,
     pub(super) debug_device: Option<ext::debug_utils::Device>,
-    pub physical: vk::PhysicalDevice,
-    pub device: ash::Device,
+    pub(super) physical: vk::PhysicalDevice,
+    pub(super) device: ash::Device,
     pub queue_family: u32,
     queue: Mutex<vk::Queue>,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,

@@ -25,7 +25,7 @@ pub struct BufferDesc<'a> {
 }
 
 pub struct Buffer {
-    pub raw: vk::Buffer,
+    pub(super) raw: vk::Buffer,
     pub size: u64,
     pub name: String,
     allocation: Option<Allocation>,
@@ -94,8 +94,8 @@ pub struct ImageDesc<'a> {
 }
 
 pub struct Image {
-    pub raw: vk::Image,
-    pub view: vk::ImageView,
+    pub(super) raw: vk::Image,
+    pub(super) view: vk::ImageView,
     pub extent: vk::Extent2D,
     pub layers: u32,
     pub format: vk::Format,

@@ -28,7 +28,6 @@ pub mod swapchain;
 
 pub use access::{Access, ImageUse};
 pub use adapter::AdapterInfo;
-pub use ash::vk;
 /// The plain Vulkan value types the layers above describe resources and frames with; they name no flags and call
 /// no Vulkan (synchronisation and usage are said in [`Access`]es).
 pub use ash::vk::{
@@ -40,6 +39,8 @@ pub use instance::ContextOptions;
 pub use memory::{Buffer, BufferDesc, Image, ImageDesc, MemoryLocation};
 pub use profiler::{Profiler, ScopeTiming};
 pub use submit::{Recorder, SubmissionId};
+
+use ash::vk;
 
 /// Everything that can go wrong in the backend. The failing Vulkan call travels with its result.
 #[derive(Debug, thiserror::Error)]

@@ -2,7 +2,7 @@
 
 use ash::vk;
 
-use super::{Context, GpuError, VkResultExt};
+use super::{Context, GpuError, Image, VkResultExt};
 
 /// Creates a shader module from SPIR-V bytes produced by build.rs.
 pub fn shader_module(
@@ -66,8 +66,8 @@ impl BufferSetLayout {
 
 /// A compute pipeline and its layout.
 pub struct ComputePipeline {
-    pub pipeline: vk::Pipeline,
-    pub layout: vk::PipelineLayout,
+    pub(super) pipeline: vk::Pipeline,
+    pub(super) layout: vk::PipelineLayout,
 }
 
 /// What a compute pipeline needs, as [`GraphicsDesc`] says it for graphics.
@@ -198,8 +198,8 @@ pub enum Blend {
 
 /// A graphics pipeline and its layout.
 pub struct GraphicsPipeline {
-    pub pipeline: vk::Pipeline,
-    pub layout: vk::PipelineLayout,
+    pub(super) pipeline: vk::Pipeline,
+    pub(super) layout: vk::PipelineLayout,
 }
 
 impl GraphicsPipeline {
@@ -348,13 +348,39 @@ impl GraphicsPipeline {
     }
 }
 
-/// The attachments of one rendering pass (raw handles, so that swapchain images can be targets too).
+/// The attachments of one rendering pass: a colour image (one of our [`Image`]s, or a swapchain's image, which is
+/// not) and a depth image, made by [`RenderTarget::new`] or [`super::swapchain::Swapchain::target`].
 #[derive(Clone, Copy, Debug)]
 pub struct RenderTarget {
-    pub color_image: vk::Image,
-    pub color_view: vk::ImageView,
-    pub depth_image: vk::Image,
-    pub depth_view: vk::ImageView,
-    pub extent: vk::Extent2D,
-    pub clear_color: [f32; 4],
+    pub(super) color_image: vk::Image,
+    pub(super) color_view: vk::ImageView,
+    pub(super) depth_image: vk::Image,
+    pub(super) depth_view: vk::ImageView,
+    pub(super) extent: vk::Extent2D,
+    pub(super) clear_color: [f32; 4],
+}
+
+/// Which attachment of a [`RenderTarget`] a barrier is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Attachment {
+    Color,
+    Depth,
+}
+
+impl RenderTarget {
+    /// Our `color` and `depth` images (of one size), the colour cleared to `clear_color`.
+    pub fn new(color: &Image, depth: &Image, clear_color: [f32; 4]) -> Self {
+        Self {
+            color_image: color.raw,
+            color_view: color.view,
+            depth_image: depth.raw,
+            depth_view: depth.view,
+            extent: color.extent,
+            clear_color,
+        }
+    }
+
+    pub fn extent(&self) -> vk::Extent2D {
+        self.extent
+    }
 }

@@ -56,7 +56,7 @@ pub struct SubmissionId(pub u64);
 pub struct Recorder<'a> {
     pub(super) ctx: &'a Context,
     pool: vk::CommandPool,
-    pub cmd: vk::CommandBuffer,
+    pub(super) cmd: vk::CommandBuffer,
     /// Buffers this recording uses and frees once its submission completed (staging, per-dispatch inputs).
     pub(super) owned: Vec<Buffer>,
     /// Transient pool for per-dispatch descriptor sets.

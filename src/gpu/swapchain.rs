@@ -6,7 +6,7 @@ use std::ffi::CStr;
 use ash::{khr, vk};
 use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
 
-use super::{Context, GpuError, VkResultExt};
+use super::{pipeline::RenderTarget, Context, GpuError, Image, VkResultExt};
 
 /// The instance extensions a window on `display` needs.
 pub fn surface_extensions(display: RawDisplayHandle) -> Result<Vec<&'static CStr>, GpuError> {
@@ -21,7 +21,7 @@ pub fn surface_extensions(display: RawDisplayHandle) -> Result<Vec<&'static CStr
 
 pub struct Surface {
     loader: khr::surface::Instance,
-    pub raw: vk::SurfaceKHR,
+    raw: vk::SurfaceKHR,
 }
 
 impl Surface {
@@ -59,9 +59,9 @@ impl Surface {
 
 pub struct Swapchain {
     loader: khr::swapchain::Device,
-    pub raw: vk::SwapchainKHR,
-    pub images: Vec<vk::Image>,
-    pub views: Vec<vk::ImageView>,
+    raw: vk::SwapchainKHR,
+    images: Vec<vk::Image>,
+    views: Vec<vk::ImageView>,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     /// Acquire semaphores, used in turn: one more than the most frames in flight, so the one acquired next is never
@@ -75,6 +75,18 @@ pub struct Swapchain {
 pub const SWAPCHAIN_FORMAT: vk::Format = vk::Format::B8G8R8A8_UNORM;
 
 impl Swapchain {
+    /// The target of a frame drawn into image `index` (from `acquire`) with `depth`, cleared to `clear_color`.
+    pub fn target(&self, index: u32, depth: &Image, clear_color: [f32; 4]) -> RenderTarget {
+        RenderTarget {
+            color_image: self.images[index as usize],
+            color_view: self.views[index as usize],
+            depth_image: depth.raw,
+            depth_view: depth.view,
+            extent: self.extent,
+            clear_color,
+        }
+    }
+
     /// A swapchain of `SWAPCHAIN_FORMAT` for `surface`, sized to the surface (or `width x height` when the
     /// surface leaves it to us), FIFO presentation.
     pub fn new(

@@ -41,14 +41,7 @@ impl Offscreen {
     }
 
     pub fn target(&self, clear_color: [f32; 4]) -> RenderTarget {
-        RenderTarget {
-            color_image: self.color.raw,
-            color_view: self.color.view,
-            depth_image: self.depth.raw,
-            depth_view: self.depth.view,
-            extent: self.color.extent,
-            clear_color,
-        }
+        RenderTarget::new(&self.color, &self.depth, clear_color)
     }
 
     /// Reads the colour image (after a frame left it in COLOR_ATTACHMENT_OPTIMAL) as RGBA8.

@@ -14,8 +14,8 @@ use super::{
 };
 use crate::{
     gpu::{
-        pipeline::RenderTarget, Access, Buffer, BufferDesc, GpuError, ImageUse, MemoryLocation,
-        Recorder,
+        pipeline::{Attachment, RenderTarget},
+        Access, Buffer, BufferDesc, GpuError, ImageUse, MemoryLocation, Recorder,
     },
     planet::cube::{PatchId, EDGES},
     runtime::{camera::Camera, lod::Selected},
@@ -350,8 +350,8 @@ impl Renderer<'_> {
         // The target is cleared, so its contents are discarded; the wait for the earlier writes to it (the frame
         // before, which may still be in flight, or the swapchain's acquire, waited for at colour output) stays.
         rec.attachment_barrier(
-            target.color_image,
-            false,
+            target,
+            Attachment::Color,
             ImageUse {
                 before: &[Access::ColorAttachment],
                 after: &[Access::ColorAttachment],
@@ -359,8 +359,8 @@ impl Renderer<'_> {
             },
         );
         rec.attachment_barrier(
-            target.depth_image,
-            true,
+            target,
+            Attachment::Depth,
             ImageUse {
                 before: &[Access::DepthAttachment],
                 after: &[Access::DepthAttachment],
@@ -415,13 +415,13 @@ impl Renderer<'_> {
             self.frames.profiler().end(rec, scope);
         }
         if let Some(draw) = overlay {
-            draw(rec, target.extent);
+            draw(rec, target.extent());
         }
         rec.end_rendering();
         if after != Access::ColorAttachment {
             rec.attachment_barrier(
-                target.color_image,
-                false,
+                target,
+                Attachment::Color,
                 ImageUse {
                     before: &[Access::ColorAttachment],
                     after: &[after],

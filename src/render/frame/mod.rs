@@ -392,7 +392,7 @@ impl<'w> Renderer<'w> {
         };
         let mut cpu = BTreeMap::new();
 
-        self.lod = self.lod_params(camera, target.extent.height);
+        self.lod = self.lod_params(camera, target.extent().height);
         let visible = self.visible_patches(camera, &mut stats, &mut cpu);
         let plan = self.plan_streaming(camera, &visible, &mut stats)?;
 

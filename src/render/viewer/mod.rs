@@ -38,7 +38,6 @@ use super::{
 use crate::{
     config::LodRule,
     gpu::{
-        pipeline::RenderTarget,
         swapchain::{self, Surface, Swapchain, SWAPCHAIN_FORMAT},
         Access, Context, ContextOptions, GpuError, Image,
     },
@@ -282,14 +281,7 @@ impl App<'_> {
         let Some((index, acquired, rendered)) = swapchain.acquire()? else {
             return self.recreate_swapchain();
         };
-        let target = RenderTarget {
-            color_image: swapchain.images[index as usize],
-            color_view: swapchain.views[index as usize],
-            depth_image: depth.raw,
-            depth_view: depth.view,
-            extent,
-            clear_color: [0.02, 0.03, 0.06, 1.0],
-        };
+        let target = swapchain.target(index, depth, [0.02, 0.03, 0.06, 1.0]);
         if let (Some(overlay), Some(window)) = (&mut self.overlay, &self.window) {
             overlay.prepare(self.ctx, window, renderer, (&info, &self.last_stats))?;
         }
