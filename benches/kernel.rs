@@ -52,9 +52,6 @@ fn kernel(c: &mut Criterion) {
                     })
                 });
             }
-            kernel.destroy(&ctx);
-            ctx.wait_idle().ok();
-            bindless.destroy(&ctx);
         }
         Err(e) => eprintln!("no Vulkan device, GPU kernels not measured: {e}"),
     }

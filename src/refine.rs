@@ -83,7 +83,6 @@ impl HeightRefiner {
         let pipeline = match pipeline {
             Ok(p) => p,
             Err(e) => {
-                jobs_layout.destroy(ctx);
                 return Err(e);
             }
         };
@@ -177,11 +176,6 @@ impl HeightRefiner {
         }
         rec.buffer_barrier(&out.buffer, &[Access::ComputeWrite], &[Access::HostRead]);
         Ok(Some(out))
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        self.pipeline.destroy(ctx);
-        self.jobs_layout.destroy(ctx);
     }
 }
 

@@ -218,8 +218,6 @@ fn gpu_refinement_equals_the_cpu_reference_bit_for_bit() {
     }
     common::assert_no_validation_errors(ctx);
     ctx.wait_idle().unwrap();
-    refiner.destroy(ctx);
-    bindless.destroy(ctx);
 }
 
 /// The screen-space error's bounds (beyond the thesis): no vertex of the finest drawn level stands further from a

@@ -53,7 +53,6 @@ fn a_flight_keeps_two_frames_in_flight_and_passes_synchronization_validation() {
         returned_early >= frames as usize / 4,
         "only {returned_early} of {frames} frames were still on the GPU when render returned"
     );
-    renderer.destroy();
     drop(target);
     eprintln!(
         "synchronization hazards waived through the bindless set's runtime arrays: {}",
@@ -77,7 +76,6 @@ fn one_frame_in_flight_waits_for_every_frame_as_the_thesis() {
         assert_eq!(stats.synchronized_frame + 1, stats.frame);
     }
     assert!(renderer.set_frames_in_flight(4).is_err(), "at most three");
-    renderer.destroy();
     drop(target);
     common::assert_no_validation_errors(ctx);
 }

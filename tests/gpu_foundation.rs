@@ -6,9 +6,86 @@ use riverplanet::{
     gpu::{
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
         Access, BufferDesc, Extent2D, Format, ImageDesc, ImageUse, MemoryLocation, Profiler,
+        Recorder,
     },
     shaders,
 };
+
+/// Issue 37: a pipeline, its set layout and the buffer it writes, dropped after a dispatch that uses them was
+/// recorded and before that recording is submitted, live until the dispatch has run: a garbage collection meanwhile
+/// (another frame's) frees none of them, the result is right, and validation reports no use of a destroyed object.
+/// Tagged with the last submitted value, as they were before, that collection freed them.
+#[test]
+fn objects_dropped_while_a_recording_uses_them_live_until_it_has_run() {
+    let Some(own) = common::own_gpu() else { return };
+    let ctx = &own;
+    ctx.run_and_wait("first submission", |_| Ok(())).unwrap();
+    const COUNT: u32 = 256;
+    let size = COUNT as u64 * 4;
+    let out = ctx
+        .create_buffer(&BufferDesc {
+            name: "dropped output",
+            size,
+            uses: &[Access::ComputeWrite, Access::TransferRead],
+            location: MemoryLocation::GpuOnly,
+        })
+        .unwrap();
+    let readback = ctx
+        .create_buffer(&BufferDesc {
+            name: "kept readback",
+            size,
+            uses: &[Access::TransferWrite, Access::HostRead],
+            location: MemoryLocation::GpuToCpu,
+        })
+        .unwrap();
+    let sets = BufferSetLayout::new(ctx, 1, "dropped set layout").unwrap();
+    let pipeline = ComputePipeline::new(
+        ctx,
+        &ComputeDesc {
+            name: "dropped fill",
+            spirv: shaders::FILL_COMP,
+            set_layouts: &[sets.layout],
+            push_constant_bytes: 12,
+            specialization: &[],
+            full_subgroups: None,
+        },
+    )
+    .unwrap();
+    let push: [u32; 3] = [2.0f32.to_bits(), 1.0f32.to_bits(), COUNT];
+    let mut rec = Recorder::begin(ctx, "drop while recorded").unwrap();
+    let set = rec.buffer_set(&sets, &[&out]).unwrap();
+    rec.dispatch(
+        &pipeline,
+        &[set],
+        bytemuck::cast_slice(&push),
+        [COUNT.div_ceil(64), 1, 1],
+    );
+    rec.buffer_barrier(&out, &[Access::ComputeWrite], &[Access::TransferRead]);
+    rec.copy_buffer(&out, &readback, size);
+    let before = ctx.retired_objects();
+    drop(pipeline);
+    drop(sets);
+    drop(out);
+    assert_eq!(ctx.retired_objects(), before + 3);
+    ctx.collect_garbage();
+    assert_eq!(
+        ctx.retired_objects(),
+        before + 3,
+        "objects a recorded command uses were freed before its submission"
+    );
+    let id = rec.submit().unwrap();
+    ctx.wait(id).unwrap();
+    assert_eq!(
+        ctx.retired_objects(),
+        0,
+        "the submission's objects outlived it"
+    );
+    let values: &[f32] = bytemuck::cast_slice(readback.mapped().unwrap());
+    for (i, v) in values.iter().enumerate() {
+        assert_eq!(*v, i as f32 * 2.0 + 1.0, "value {i}");
+    }
+    common::assert_no_validation_errors(ctx);
+}
 
 #[test]
 fn compute_dispatch_reads_back_and_is_timed() {
@@ -76,9 +153,6 @@ fn compute_dispatch_reads_back_and_is_timed() {
         timings[0].ms
     );
 
-    profiler.destroy(ctx);
-    pipeline.destroy(ctx);
-    sets.destroy(ctx);
     drop(out);
     drop(readback);
     ctx.wait_idle().unwrap();

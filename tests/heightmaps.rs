@@ -616,7 +616,6 @@ fn the_exported_surface_is_the_surface_the_renderer_draws() {
     renderer.capture_vertices = true;
     renderer.render_until_streamed(&camera, &clear, 1).unwrap();
     let capture = renderer.last_capture.take().unwrap();
-    renderer.destroy();
     drop(offscreen);
     common::assert_no_validation_errors(ctx);
 

@@ -128,7 +128,6 @@ fn descend(ctx: &Context, morphing: bool) -> (f64, usize) {
         previous = Some(capture);
         altitude *= 0.9975;
     }
-    renderer.destroy();
     (largest, compared)
 }
 

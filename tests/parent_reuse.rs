@@ -145,10 +145,6 @@ fn reuse_against_scratch(world: &World, parent: PatchId) -> (f32, f32) {
         }
     }
     ctx.wait_idle().unwrap();
-    kernel.destroy(ctx);
-    parent_out.destroy(ctx, &mut bindless);
-    child_out.destroy(ctx, &mut bindless);
-    bindless.destroy(ctx);
     common::assert_no_validation_errors(ctx);
     (diff, tolerance)
 }
@@ -208,7 +204,6 @@ fn ground_vertices(parent_reuse: bool) -> Option<(VertexCapture, usize)> {
     renderer.capture_vertices = true;
     renderer.render_until_streamed(&camera, &target, 1).unwrap();
     let capture = renderer.last_capture.take().unwrap();
-    renderer.destroy();
     common::assert_no_validation_errors(ctx);
     Some((capture, from_parent))
 }

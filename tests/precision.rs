@@ -66,7 +66,6 @@ fn two_metres_above_an_earth_sized_river_vertices_are_exact_to_a_millimetre_and_
     let side = (look_at - eye).cross(eye).normalize() * 0.01;
     frame(&mut renderer, &camera_at(side), true, 1);
     let after = renderer.last_capture.take().unwrap();
-    renderer.destroy();
     assert!(
         deepest >= 20,
         "deepest level {deepest} two metres above the water"

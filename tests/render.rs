@@ -362,7 +362,6 @@ fn render_configured(
         .render_until_streamed(camera, &target.target(clear), 100)
         .unwrap();
     let image = target.read(ctx).unwrap();
-    renderer.destroy();
     drop(target);
     image
 }

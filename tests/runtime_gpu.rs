@@ -105,9 +105,7 @@ fn river_data_is_identical_alone_in_a_batch_and_after_recomputing() {
             );
         }
     }
-    kernel.destroy(ctx);
     ctx.wait_idle().unwrap();
-    bindless.destroy(ctx);
     common::assert_no_validation_errors(ctx);
 }
 
@@ -150,7 +148,6 @@ fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
         evicted > 0,
         "the flight never filled the cache, so the budget was not tested"
     );
-    renderer.destroy();
     ctx.wait_idle().unwrap();
     common::assert_no_validation_errors(ctx);
 }

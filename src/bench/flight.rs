@@ -338,7 +338,6 @@ fn fly(
         attribute_gpu_times(&mut frames, renderer.take_gpu_times());
         Ok(())
     })();
-    renderer.destroy();
     result.map(|()| frames)
 }
 
@@ -496,9 +495,6 @@ pub fn flight_bench(
         runner.as_mut(),
         |f| progress("auto", f),
     );
-    if let Some(r) = runner {
-        r.destroy(ctx);
-    }
     let frames = frames?;
     let mut summary = summarise(&frames, config.rendering.max_resident_patches as usize);
     summary

@@ -279,14 +279,6 @@ impl VariantRunner {
         };
         Ok((variants, reference, diffs))
     }
-
-    pub fn destroy(self, ctx: &Context) {
-        self.kernel.destroy(ctx);
-        let _ = ctx.wait_idle();
-        let mut bindless = self.bindless;
-        self.outputs.destroy(ctx, &mut bindless);
-        bindless.destroy(ctx);
-    }
 }
 
 /// `riverplanet bench kernel`.
@@ -304,7 +296,6 @@ pub fn kernel_bench(
     let jobs: Vec<PatchJob> = PatchJob::from_pairs(&patches);
     let mut runner = VariantRunner::new(ctx, jobs.len(), n, tuning)?;
     let measured = runner.measure(ctx, &jobs, &params, repetitions, true);
-    runner.destroy(ctx);
     let (variants, reference, diffs) = measured?;
     let max_abs_diff = diffs.max();
     let heights = reference.iter().flatten().map(|t| t.terrain_height);

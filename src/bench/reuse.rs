@@ -195,11 +195,6 @@ pub fn reuse_bench(
             gpu(KernelVariant::Tiled, true)?,
         ])
     });
-    let _ = ctx.wait_idle();
-    kernel.destroy(ctx);
-    parent_out.destroy(ctx, &mut bindless);
-    child_out.destroy(ctx, &mut bindless);
-    bindless.destroy(ctx);
     let [simple_scratch, simple_reuse, tiled_scratch, tiled_reuse] = measured?;
 
     let vertices = (n * n) as u64 * children.len() as u64;

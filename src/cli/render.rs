@@ -126,7 +126,6 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     }
     println!("  frame     {:8.3} ms", stats.frame_ms);
     let errors = ctx.validation_errors();
-    renderer.destroy();
     if !errors.is_empty() {
         anyhow::bail!(
             "validation reported {} error(s): {}",

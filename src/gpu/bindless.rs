@@ -5,7 +5,10 @@
 
 use ash::vk;
 
-use super::{Access, Context, GpuError, Image, VkResultExt};
+use super::{
+    memory::{RetireOnDrop, Retired},
+    Access, Context, GpuError, Image, VkResultExt,
+};
 
 /// The debug name of the set, which validation messages quote.
 pub(crate) const SET_NAME: &str = "bindless set";
@@ -15,7 +18,6 @@ pub const SAMPLED_IMAGES: u32 = 1;
 
 pub struct Bindless {
     pub layout: vk::DescriptorSetLayout,
-    pool: vk::DescriptorPool,
     pub set: vk::DescriptorSet,
     sampler: vk::Sampler,
     pub capacity: u32,
@@ -23,6 +25,7 @@ pub struct Bindless {
     /// Released slots with the timeline value after which no submitted frame reads them: a frame still in
     /// flight may read a slot's descriptor, which must not be rewritten until that frame has finished.
     released: std::collections::VecDeque<(u64, u32)>,
+    _retire: RetireOnDrop,
 }
 
 /// A slot index in the bindless arrays, as shaders see it.
@@ -74,9 +77,10 @@ impl Bindless {
             .flags(vk::DescriptorSetLayoutCreateFlags::UPDATE_AFTER_BIND_POOL)
             .bindings(&bindings)
             .push_next(&mut flag_info);
-        // SAFETY: valid create infos; destroyed in `destroy`.
+        // SAFETY: valid create infos; each object is retired when the set drops (or creation fails further on).
         let layout = unsafe { ctx.device.create_descriptor_set_layout(&layout_info, None) }
             .vk("vkCreateDescriptorSetLayout")?;
+        let mut retire = ctx.retire_on_drop(vec![Retired::SetLayout(layout)]);
         ctx.set_name(layout, "bindless layout");
         let sizes = [
             vk::DescriptorPoolSize {
@@ -94,6 +98,7 @@ impl Bindless {
             .pool_sizes(&sizes);
         let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
             .vk("vkCreateDescriptorPool")?;
+        retire.push(Retired::DescriptorPool(pool));
         let counts = [capacity];
         let mut variable = vk::DescriptorSetVariableDescriptorCountAllocateInfo::default()
             .descriptor_counts(&counts);
@@ -114,15 +119,16 @@ impl Bindless {
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
         let sampler =
             unsafe { ctx.device.create_sampler(&sampler_info, None) }.vk("vkCreateSampler")?;
+        retire.push(Retired::Sampler(sampler));
         ctx.set_name(sampler, "bindless linear clamp sampler");
         Ok(Self {
             layout,
-            pool,
             set,
             sampler,
             capacity,
             free: (0..capacity).rev().collect(),
             released: Default::default(),
+            _retire: retire,
         })
     }
 
@@ -190,14 +196,5 @@ impl Bindless {
         }
         // SAFETY: UPDATE_AFTER_BIND permits updates while the set is bound; the slot is not used by pending work.
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        // SAFETY: called after the device finished all work using the set (wait_idle at shutdown).
-        unsafe {
-            ctx.device.destroy_sampler(self.sampler, None);
-            ctx.device.destroy_descriptor_pool(self.pool, None);
-            ctx.device.destroy_descriptor_set_layout(self.layout, None);
-        }
     }
 }

@@ -8,6 +8,7 @@
 use ash::vk;
 
 use super::{
+    memory::{RetireOnDrop, Retired},
     submit::{allocate_command_buffer, transient_command_pool, transient_descriptor_pool},
     Context, GpuError, Profiler, Recorder, ScopeTiming, SubmissionId, VkResultExt,
 };
@@ -32,6 +33,7 @@ struct FrameContext<T> {
     descriptor_pool: vk::DescriptorPool,
     profiler: Profiler,
     in_flight: Option<(SubmissionId, T)>,
+    _retire: RetireOnDrop,
 }
 
 /// The ring of frame contexts; `T` is what the caller reads back once a frame has finished.
@@ -53,9 +55,11 @@ impl<T> FrameRing<T> {
         let frames = (0..count)
             .map(|i| {
                 let pool = transient_command_pool(ctx)?;
+                let mut retire = ctx.retire_on_drop(vec![Retired::Pool(pool)]);
                 let cmd = allocate_command_buffer(ctx, pool)?;
                 ctx.set_name(pool, &format!("{name} {i} commands"));
                 let descriptor_pool = transient_descriptor_pool(ctx)?;
+                retire.push(Retired::DescriptorPool(descriptor_pool));
                 let profiler = Profiler::new(ctx, max_scopes, &format!("{name} {i} timestamps"))?;
                 Ok(FrameContext {
                     pool,
@@ -63,6 +67,7 @@ impl<T> FrameRing<T> {
                     descriptor_pool,
                     profiler,
                     in_flight: None,
+                    _retire: retire,
                 })
             })
             .collect::<Result<_, GpuError>>()?;
@@ -151,14 +156,5 @@ impl<T> FrameRing<T> {
             timings,
             payload,
         }))
-    }
-
-    /// Frees the ring's objects once nothing in flight uses them (call after the device is idle or `drain`).
-    pub fn destroy(self, ctx: &Context) {
-        for frame in self.frames {
-            ctx.retire_command_pool(frame.pool);
-            ctx.retire_descriptor_pool(frame.descriptor_pool);
-            frame.profiler.destroy(ctx);
-        }
     }
 }

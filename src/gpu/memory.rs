@@ -1,7 +1,8 @@
-//! Named buffers and images on gpu-allocator memory, and deferred destruction: a dropped buffer or image (or a
-//! retired pool) is freed only after the GPU has finished every submission made before it was dropped (Granite's
+//! Named buffers and images on gpu-allocator memory, and deferred destruction: a dropped buffer or image (or
+//! pipeline, layout, sampler or pool, through [`RetireOnDrop`]) is freed only after the GPU has finished every
+//! submission made before it was dropped, and the submission of any recording open when it was dropped (Granite's
 //! per-frame lists, keyed here by timeline-semaphore value). Dropping is retiring, so none can leak by being
-//! forgotten.
+//! forgotten, and no owner calls `destroy`.
 
 use std::sync::{atomic::AtomicU64, Arc, Mutex};
 
@@ -13,6 +14,27 @@ use super::{
     access::{self, Access},
     Context, GpuError, VkResultExt,
 };
+
+/// GPU objects retired when their owner drops (see [`Context::retire_on_drop`]).
+pub(super) struct RetireOnDrop {
+    items: Vec<Retired>,
+    deletion: Arc<DeletionQueue>,
+}
+
+impl RetireOnDrop {
+    /// Adds an object just created, so that a failure further on retires it with the rest.
+    pub(super) fn push(&mut self, item: Retired) {
+        self.items.push(item);
+    }
+}
+
+impl Drop for RetireOnDrop {
+    fn drop(&mut self) {
+        for item in self.items.drain(..) {
+            self.deletion.retire(item);
+        }
+    }
+}
 
 /// A buffer request. `name` goes to the debug-utils object name and to the allocation.
 #[derive(Clone, Debug)]
@@ -137,44 +159,92 @@ fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
     }
 }
 
-enum Retired {
+/// A GPU object waiting to be destroyed.
+pub(super) enum Retired {
     Buffer(vk::Buffer, Option<Allocation>),
     Image(vk::Image, vk::ImageView, Option<Allocation>),
     Pool(vk::CommandPool),
     DescriptorPool(vk::DescriptorPool),
     QueryPool(vk::QueryPool),
+    Pipeline(vk::Pipeline, vk::PipelineLayout),
+    SetLayout(vk::DescriptorSetLayout),
+    Sampler(vk::Sampler),
 }
 
-/// Resources waiting for the GPU to finish with them, each tagged with the timeline value that must complete first:
-/// the last one submitted when it was retired (`submitted`, shared with the timeline).
+/// Objects retired and when they may be destroyed.
+#[derive(Default)]
+struct Pending {
+    /// Each with the timeline value that must complete first.
+    tagged: Vec<(u64, Retired)>,
+    /// Retired while a recording was open: that recording may use them, and its submission's value is not known
+    /// yet, so they wait for every open recording to be submitted (or abandoned) and take the value then.
+    awaiting: Vec<Retired>,
+    /// Recordings begun and not yet submitted or dropped.
+    open: usize,
+}
+
+/// Resources waiting for the GPU to finish with them. With no recording open, what is retired waits for the last
+/// submission (`submitted`, shared with the timeline); with recordings open, for the last of their submissions:
+/// an object dropped after a command that uses it was recorded lives until that command has run.
 pub(crate) struct DeletionQueue {
-    pending: Mutex<Vec<(u64, Retired)>>,
+    pending: Mutex<Pending>,
     submitted: Arc<AtomicU64>,
 }
 
 impl DeletionQueue {
     pub(crate) fn new(submitted: Arc<AtomicU64>) -> Self {
         Self {
-            pending: Mutex::new(Vec::new()),
+            pending: Mutex::new(Pending::default()),
             submitted,
         }
     }
 
-    fn retire(&self, item: Retired) {
-        let after = self.submitted.load(std::sync::atomic::Ordering::Acquire);
-        self.pending
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push((after, item));
+    fn lock(&self) -> std::sync::MutexGuard<'_, Pending> {
+        self.pending.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub(super) fn retire(&self, item: Retired) {
+        let mut pending = self.lock();
+        if pending.open == 0 {
+            let after = self.submitted.load(std::sync::atomic::Ordering::Acquire);
+            pending.tagged.push((after, item));
+        } else {
+            pending.awaiting.push(item);
+        }
+    }
+
+    /// A recording began: what is retired from now on may be used by it.
+    pub(super) fn recording_opened(&self) {
+        self.lock().open += 1;
+    }
+
+    /// A recording was submitted (after the timeline took its value) or abandoned. When none is left open, what
+    /// waited for them takes the last submitted value.
+    pub(super) fn recording_closed(&self) {
+        let mut pending = self.lock();
+        pending.open = pending.open.saturating_sub(1);
+        if pending.open == 0 && !pending.awaiting.is_empty() {
+            let after = self.submitted.load(std::sync::atomic::Ordering::Acquire);
+            let awaiting = std::mem::take(&mut pending.awaiting);
+            pending
+                .tagged
+                .extend(awaiting.into_iter().map(|item| (after, item)));
+        }
+    }
+
+    /// How many objects wait to be destroyed.
+    pub(super) fn len(&self) -> usize {
+        let pending = self.lock();
+        pending.tagged.len() + pending.awaiting.len()
     }
 
     /// Frees every resource whose guarding submission has completed.
     fn collect(&self, device: &ash::Device, allocator: &Mutex<Allocator>, completed: u64) {
         let ready: Vec<Retired> = {
-            let mut pending = self.pending.lock().unwrap_or_else(|e| e.into_inner());
+            let mut pending = self.lock();
             let (ready, keep): (Vec<_>, Vec<_>) =
-                pending.drain(..).partition(|(v, _)| *v <= completed);
-            *pending = keep;
+                pending.tagged.drain(..).partition(|(v, _)| *v <= completed);
+            pending.tagged = keep;
             ready.into_iter().map(|(_, r)| r).collect()
         };
         if ready.is_empty() {
@@ -201,12 +271,26 @@ impl DeletionQueue {
                     Retired::Pool(p) => device.destroy_command_pool(p, None),
                     Retired::DescriptorPool(p) => device.destroy_descriptor_pool(p, None),
                     Retired::QueryPool(q) => device.destroy_query_pool(q, None),
+                    Retired::Pipeline(p, l) => {
+                        device.destroy_pipeline(p, None);
+                        device.destroy_pipeline_layout(l, None);
+                    }
+                    Retired::SetLayout(l) => device.destroy_descriptor_set_layout(l, None),
+                    Retired::Sampler(x) => device.destroy_sampler(x, None),
                 }
             }
         }
     }
 
+    /// Frees everything, awaiting or not (at the context's end, with the device idle).
     pub(crate) fn flush_all(&self, device: &ash::Device, allocator: &Mutex<Allocator>) {
+        {
+            let mut pending = self.lock();
+            let awaiting = std::mem::take(&mut pending.awaiting);
+            pending
+                .tagged
+                .extend(awaiting.into_iter().map(|item| (0, item)));
+        }
         self.collect(device, allocator, u64::MAX);
     }
 }
@@ -329,16 +413,18 @@ impl Context {
         })
     }
 
-    pub(crate) fn retire_command_pool(&self, pool: vk::CommandPool) {
-        self.deletion.retire(Retired::Pool(pool));
+    /// A guard that retires `items` (through the deletion queue, as a dropped buffer is) when it drops: the
+    /// owner of pipelines, layouts, samplers and pools holds one, and needs no `destroy` call.
+    pub(super) fn retire_on_drop(&self, items: Vec<Retired>) -> RetireOnDrop {
+        RetireOnDrop {
+            items,
+            deletion: self.deletion.clone(),
+        }
     }
 
-    pub(crate) fn retire_descriptor_pool(&self, pool: vk::DescriptorPool) {
-        self.deletion.retire(Retired::DescriptorPool(pool));
-    }
-
-    pub(crate) fn retire_query_pool(&self, pool: vk::QueryPool) {
-        self.deletion.retire(Retired::QueryPool(pool));
+    /// Objects retired and not yet destroyed (the GPU may still use them).
+    pub fn retired_objects(&self) -> usize {
+        self.deletion.len()
     }
 
     /// How many buffers and images hold memory (live, or retired and not yet freed): for leak checks.

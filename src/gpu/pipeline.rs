@@ -2,7 +2,10 @@
 
 use ash::vk;
 
-use super::{Context, GpuError, Image, VkResultExt};
+use super::{
+    memory::{RetireOnDrop, Retired},
+    Context, GpuError, Image, VkResultExt,
+};
 
 /// Creates a shader module from SPIR-V bytes produced by build.rs.
 pub fn shader_module(
@@ -37,6 +40,7 @@ fn specialization_entries(data: &[u8]) -> Vec<vk::SpecializationMapEntry> {
 pub struct BufferSetLayout {
     pub layout: vk::DescriptorSetLayout,
     pub count: u32,
+    _retire: RetireOnDrop,
 }
 
 impl BufferSetLayout {
@@ -55,19 +59,19 @@ impl BufferSetLayout {
         let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
             .vk("vkCreateDescriptorSetLayout")?;
         ctx.set_name(layout, name);
-        Ok(Self { layout, count })
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        // SAFETY: called after all work using the layout completed.
-        unsafe { ctx.device.destroy_descriptor_set_layout(self.layout, None) };
+        Ok(Self {
+            layout,
+            count,
+            _retire: ctx.retire_on_drop(vec![Retired::SetLayout(layout)]),
+        })
     }
 }
 
-/// A compute pipeline and its layout.
+/// A compute pipeline and its layout, retired when dropped.
 pub struct ComputePipeline {
     pub(super) pipeline: vk::Pipeline,
     pub(super) layout: vk::PipelineLayout,
+    _retire: RetireOnDrop,
 }
 
 /// What a compute pipeline needs, as [`GraphicsDesc`] says it for graphics.
@@ -149,15 +153,11 @@ impl ComputePipeline {
             }
         };
         ctx.set_name(pipeline, name);
-        Ok(Self { pipeline, layout })
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        // SAFETY: called after all work using the pipeline completed.
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-        }
+        Ok(Self {
+            pipeline,
+            layout,
+            _retire: ctx.retire_on_drop(vec![Retired::Pipeline(pipeline, layout)]),
+        })
     }
 }
 
@@ -196,10 +196,11 @@ pub enum Blend {
     Transmit,
 }
 
-/// A graphics pipeline and its layout.
+/// A graphics pipeline and its layout, retired when dropped.
 pub struct GraphicsPipeline {
     pub(super) pipeline: vk::Pipeline,
     pub(super) layout: vk::PipelineLayout,
+    _retire: RetireOnDrop,
 }
 
 impl GraphicsPipeline {
@@ -330,20 +331,16 @@ impl GraphicsPipeline {
         match result {
             Ok(pipeline) => {
                 ctx.set_name(pipeline, desc.name);
-                Ok(Self { pipeline, layout })
+                Ok(Self {
+                    pipeline,
+                    layout,
+                    _retire: ctx.retire_on_drop(vec![Retired::Pipeline(pipeline, layout)]),
+                })
             }
             Err(e) => {
                 unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
                 Err(e)
             }
-        }
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        // SAFETY: called after all work using the pipeline completed.
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
         }
     }
 }

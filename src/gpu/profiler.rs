@@ -4,7 +4,10 @@
 
 use ash::vk;
 
-use super::{Context, GpuError, Recorder, VkResultExt};
+use super::{
+    memory::{RetireOnDrop, Retired},
+    Context, GpuError, Recorder, VkResultExt,
+};
 
 /// The GPU time of one named scope.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -19,6 +22,7 @@ pub struct Profiler {
     names: Vec<String>,
     period_ns: f64,
     valid_mask: u64,
+    _retire: RetireOnDrop,
 }
 
 /// An open scope; close it with [`Profiler::end`].
@@ -38,6 +42,7 @@ impl Profiler {
         let mut profiler = Self {
             pool,
             capacity: max_scopes,
+            _retire: ctx.retire_on_drop(vec![Retired::QueryPool(pool)]),
             names: Vec::new(),
             period_ns: ctx.properties.limits.timestamp_period as f64,
             valid_mask: if bits >= 64 {
@@ -127,9 +132,5 @@ impl Profiler {
                 }
             })
             .collect())
-    }
-
-    pub fn destroy(self, ctx: &Context) {
-        ctx.retire_query_pool(self.pool);
     }
 }

@@ -9,7 +9,7 @@ use std::sync::{
 
 use ash::vk;
 
-use super::{access::Access, Buffer, Context, GpuError, VkResultExt};
+use super::{access::Access, memory::Retired, Buffer, Context, GpuError, VkResultExt};
 
 /// The timeline semaphore that every submission signals.
 pub(crate) struct Timeline {
@@ -143,15 +143,18 @@ impl<'a> Recorder<'a> {
         let begin = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: the command buffer is in the initial state (fresh or its pool reset).
-        unsafe { ctx.device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
-        Ok(Self {
+        let begun =
+            unsafe { ctx.device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer");
+        ctx.deletion.recording_opened();
+        let recorder = Self {
             ctx,
             pool,
             cmd,
             owned: Vec::new(),
             descriptor_pool,
             pooled,
-        })
+        };
+        begun.map(|()| recorder)
     }
 
     pub fn ctx(&self) -> &'a Context {
@@ -260,19 +263,27 @@ impl<'a> Recorder<'a> {
             .last
             .store(value, std::sync::atomic::Ordering::Release);
         drop(queue);
-        if !self.pooled {
-            ctx.retire_command_pool(self.pool);
-            if let Some(pool) = self.descriptor_pool {
-                ctx.retire_descriptor_pool(pool);
-            }
-        }
-        // Staging and per-dispatch buffers: retired now, after this submission's value, so freed once it completes.
-        drop(self.owned);
+        // Dropping the recorder closes it: its own pools, staging and per-dispatch buffers are retired after this
+        // submission's value (or the last open recording's), so freed once it completes.
         Ok(SubmissionId(value))
     }
 
     pub fn submit(self) -> Result<SubmissionId, GpuError> {
         self.submit_with(&[], &[])
+    }
+}
+
+impl Drop for Recorder<'_> {
+    /// Closes the recording, submitted or not: what was retired while it was open, its pools when they are its
+    /// own, and the buffers it kept wait for its submission (none, if it was abandoned).
+    fn drop(&mut self) {
+        self.ctx.deletion.recording_closed();
+        if !self.pooled {
+            self.ctx.deletion.retire(Retired::Pool(self.pool));
+            if let Some(pool) = self.descriptor_pool {
+                self.ctx.deletion.retire(Retired::DescriptorPool(pool));
+            }
+        }
     }
 }
 

@@ -19,6 +19,22 @@ use riverplanet::{
 
 static CONTEXT: OnceLock<Result<Context, String>> = OnceLock::new();
 
+/// A context with validation on (unless `RIVERPLANET_VALIDATION=0`), and synchronization validation too if asked.
+fn new_context(synchronization: bool) -> Result<Context, String> {
+    let _ = env_logger::builder().is_test(true).try_init();
+    let mut options = ContextOptions::from_env();
+    options.validation = std::env::var("RIVERPLANET_VALIDATION").map_or(true, |v| v != "0");
+    options.synchronization_validation |= synchronization && options.validation;
+    Context::new(&options).map_err(|e| e.to_string())
+}
+
+/// A context of the calling test's own, for a test that counts what the context holds (the shared one is used by
+/// the binary's other tests at the same time), or `None` where `gpu` skips.
+pub fn own_gpu() -> Option<Context> {
+    gpu()?;
+    Some(new_context(false).expect("a second context on the device"))
+}
+
 /// The shared context, or `None` (test skipped) when no usable device exists and a GPU is not required.
 pub fn gpu() -> Option<&'static Context> {
     shared(&CONTEXT, false)
@@ -34,13 +50,7 @@ fn shared(
     cell: &'static OnceLock<Result<Context, String>>,
     synchronization: bool,
 ) -> Option<&'static Context> {
-    let result = cell.get_or_init(|| {
-        let _ = env_logger::builder().is_test(true).try_init();
-        let mut options = ContextOptions::from_env();
-        options.validation = std::env::var("RIVERPLANET_VALIDATION").map_or(true, |v| v != "0");
-        options.synchronization_validation |= synchronization && options.validation;
-        Context::new(&options).map_err(|e| e.to_string())
-    });
+    let result = cell.get_or_init(|| new_context(synchronization));
     let required = std::env::var("RIVERPLANET_REQUIRE_GPU").is_ok_and(|v| v == "1");
     match result {
         Ok(ctx) => {

@@ -150,12 +150,10 @@ pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
             match result {
                 Ok(r) => runs.push(r.timings.iter().map(|t| t.ms).sum::<f64>()),
                 Err(e) => {
-                    kernel.destroy(ctx);
                     return Err(e);
                 }
             }
         }
-        kernel.destroy(ctx);
         runs.remove(0);
         runs.sort_by(f64::total_cmp);
         Ok(runs[runs.len() / 2])
@@ -176,9 +174,6 @@ pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
         }
         Ok::<_, GpuError>((simple_ms, best))
     })();
-    ctx.wait_idle()?;
-    outputs.destroy(ctx, &mut bindless);
-    bindless.destroy(ctx);
     let (simple_ms, best) = timed?;
     let (tuning, tiled_ms) = best.unwrap_or((base, f64::INFINITY));
     Ok(Tuned {

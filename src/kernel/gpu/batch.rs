@@ -71,7 +71,7 @@ impl BatchOutputs {
         for k in 0..patches {
             let Some(slot) = bindless.allocate(ctx) else {
                 let capacity = bindless.capacity;
-                outputs.destroy(ctx, bindless);
+                outputs.release(ctx, bindless);
                 return Err(GpuError::Invalid(format!(
                     "batch of {patches} patches exceeds the {capacity} bindless slots"
                 )));
@@ -80,7 +80,7 @@ impl BatchOutputs {
             let image = match create_river_texture(ctx, grid_size, &format!("river texture {k}")) {
                 Ok(image) => image,
                 Err(e) => {
-                    outputs.destroy(ctx, bindless);
+                    outputs.release(ctx, bindless);
                     return Err(e);
                 }
             };
@@ -102,7 +102,7 @@ impl BatchOutputs {
 
     /// Frees the textures' slots; the textures and the read-back buffer are retired as `self` drops (freed once
     /// the GPU is done with them).
-    pub fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
+    pub fn release(self, ctx: &Context, bindless: &mut Bindless) {
         for s in self.slots {
             bindless.release(ctx, s);
         }
@@ -121,7 +121,7 @@ pub fn run_batch(
 ) -> Result<BatchResult, GpuError> {
     let outputs = BatchOutputs::new(ctx, bindless, jobs.len(), kernel.grid_size)?;
     let result = run_batch_into(ctx, bindless, kernel, variant, jobs, &[], params, &outputs);
-    outputs.destroy(ctx, bindless);
+    outputs.release(ctx, bindless);
     result
 }
 
@@ -188,6 +188,5 @@ pub fn run_batch_into(
             temporary_bytes,
         })
     });
-    profiler.destroy(ctx);
     outcome
 }

@@ -273,14 +273,6 @@ impl RiverKernel {
         rec.free_after_completion(masks);
         set.map(|_| size)
     }
-
-    pub fn destroy(self, ctx: &Context) {
-        self.simple.destroy(ctx);
-        self.reach.destroy(ctx);
-        self.tiled.destroy(ctx);
-        self.inputs.destroy(ctx);
-        self.tiled_inputs.destroy(ctx);
-    }
 }
 
 /// Creates one patch's river texture.

@@ -36,7 +36,7 @@ impl Renderer<'_> {
     pub fn set_frames_in_flight(&mut self, count: usize) -> Result<(), GpuError> {
         self.finish()?;
         let ring = FrameRing::new(self.ctx, count, TIMESTAMP_SCOPES, "frame")?;
-        std::mem::replace(&mut self.frames, ring).destroy(self.ctx);
+        self.frames = ring;
         Ok(())
     }
 

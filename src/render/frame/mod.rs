@@ -505,28 +505,4 @@ impl<'w> Renderer<'w> {
             ))
         })
     }
-
-    /// Frees every GPU object of the renderer (after the device is idle); its buffers are retired as it drops.
-    pub fn destroy(mut self) {
-        let ctx = self.ctx;
-        let _ = ctx.wait_idle();
-        for data in self.cache.drain() {
-            data.release(ctx, &mut self.bindless);
-        }
-        self.frames.destroy(ctx);
-        self.kernel.destroy(ctx);
-        self.refiner.destroy(ctx);
-        self.terrain.destroy(ctx);
-        self.terrain_unculled.destroy(ctx);
-        self.water.destroy(ctx);
-        self.cached_water.destroy(ctx);
-        self.wireframe.destroy(ctx);
-        if let Some(sky) = self.sky {
-            sky.destroy(ctx, &mut self.bindless);
-        }
-        self.instance_layout.destroy(ctx);
-        self.vertex_cache.destroy(ctx);
-        let _ = ctx.wait_idle();
-        self.bindless.destroy(ctx);
-    }
 }

@@ -172,12 +172,6 @@ impl Sky {
             0..1,
         );
     }
-
-    pub(super) fn destroy(self, ctx: &Context, bindless: &mut Bindless) {
-        self.pipeline.destroy(ctx);
-        self.dome_pipeline.destroy(ctx);
-        bindless.release(ctx, self.slot);
-    }
 }
 
 impl Renderer<'_> {

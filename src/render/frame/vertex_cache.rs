@@ -142,11 +142,6 @@ impl VertexCache {
             &[Access::IndirectCommands, Access::IndexRead],
         );
     }
-
-    pub(super) fn destroy(self, ctx: &Context) {
-        self.pipeline.destroy(ctx);
-        self.water_triangles.destroy(ctx);
-    }
 }
 
 /// A compute pipeline of the frame: it binds the frame's sets (`layouts`) and reads its push constants

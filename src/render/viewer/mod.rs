@@ -351,9 +351,7 @@ impl App<'_> {
 
     fn shutdown(&mut self) {
         let _ = self.ctx.wait_idle();
-        if let Some(renderer) = self.renderer.take() {
-            renderer.destroy();
-        }
+        self.renderer = None;
         if let Some(overlay) = self.overlay.take() {
             overlay.destroy(self.ctx);
         }
