@@ -198,10 +198,10 @@ fn staging_upload_reaches_device_local_buffer() {
     common::assert_no_validation_errors(ctx);
 }
 
-/// Dropping a buffer or an image retires it: it stays allocated while a submission that used it may run, and is
-/// freed once the GPU is done, without a call to free it.
+/// Dropping a buffer or an image retires it: it stays allocated while a submission that used it may run, and once
+/// the GPU is done it is kept for a request of its shape, or freed (`release_recycled`), without a call to free it.
 #[test]
-fn dropped_buffers_and_images_are_freed_once_the_gpu_is_done() {
+fn dropped_buffers_and_images_are_kept_or_freed_once_the_gpu_is_done() {
     if common::gpu().is_none() {
         return;
     }
@@ -248,5 +248,24 @@ fn dropped_buffers_and_images_are_freed_once_the_gpu_is_done() {
     assert_eq!(ctx.live_allocations(), before + 2);
     ctx.wait(submitted).unwrap();
     ctx.collect_garbage();
+    // Done with on the GPU: kept for reuse (gpu/retire.rs), not in use.
+    assert_eq!(ctx.retired_objects(), 0);
+    assert_eq!(ctx.recycled_objects(), 2);
+    assert_eq!(ctx.live_allocations(), before + 2);
+    // A request of the same shape takes the kept buffer instead of creating one.
+    let created = ctx.created_resources();
+    let again = ctx
+        .create_buffer(&BufferDesc {
+            name: "buffer again",
+            size: (1 << 20) - 100,
+            uses: &[Access::TransferWrite],
+            location: MemoryLocation::GpuOnly,
+        })
+        .unwrap();
+    assert_eq!(ctx.created_resources(), created);
+    assert_eq!(ctx.recycled_objects(), 1);
+    drop(again);
+    ctx.release_recycled();
+    assert_eq!(ctx.recycled_objects(), 0);
     assert_eq!(ctx.live_allocations(), before);
 }

@@ -151,3 +151,51 @@ fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
     ctx.wait_idle().unwrap();
     common::assert_no_validation_errors(ctx);
 }
+
+/// Issue 37: once warm, the frame loop creates no buffer or image. Staging, instance, vertex-cache and per-dispatch
+/// buffers come back from those earlier frames retired, and a new patch takes the textures of one the cache evicted
+/// (gpu/retire.rs). A context of its own: it counts what this flight creates.
+#[test]
+fn a_warm_frame_loop_creates_no_buffer_or_image() {
+    let Some(own) = common::own_gpu() else { return };
+    let ctx = &own;
+    let world = world();
+    let mut config = world.config.clone();
+    config.rendering.max_resident_patches = 96;
+    config.rendering.new_patches_per_frame = 16;
+    config.rendering.level_of_detail_switch_factor *= 10.0;
+    let target = Offscreen::new(ctx, 96, 64).unwrap();
+    let mut renderer = Renderer::new(
+        ctx,
+        &world.planet,
+        &world.network,
+        &config,
+        COLOR_FORMAT,
+        DEPTH_FORMAT,
+    )
+    .unwrap();
+    let (frames, warm) = (100u32, 50usize);
+    let flight = Flight::new(world, frames, 25.0, 1.5);
+    let mut evicted = 0;
+    let mut created = Vec::new();
+    for frame in 0..frames {
+        let stats = common::render_frame(&mut renderer, &flight.camera(world, frame), &target);
+        if (frame as usize) < warm {
+            evicted += stats.evicted_patches;
+        }
+        created.push(ctx.created_resources());
+    }
+    assert!(evicted > 0, "the cache did not fill during the warm-up");
+    let growth: Vec<String> = (warm..frames as usize)
+        .filter(|&f| created[f] > created[f - 1])
+        .map(|f| format!("frame {f}: {} created", created[f] - created[f - 1]))
+        .collect();
+    assert!(
+        growth.is_empty(),
+        "the warm frame loop created buffers or images:\n{}",
+        growth.join("\n")
+    );
+    drop(renderer);
+    ctx.wait_idle().unwrap();
+    common::assert_no_validation_errors(ctx);
+}

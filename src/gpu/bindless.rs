@@ -6,7 +6,7 @@
 use ash::vk;
 
 use super::{
-    memory::{RetireOnDrop, Retired},
+    retire::{RetireOnDrop, Retired},
     Access, Context, GpuError, Image, VkResultExt,
 };
 

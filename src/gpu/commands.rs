@@ -105,9 +105,13 @@ impl Recorder<'_> {
     pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
         // SAFETY: recording; the buffer outlives the submission and has TRANSFER_DST usage (validated).
         unsafe {
-            self.ctx
-                .device
-                .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
+            self.ctx.device.cmd_fill_buffer(
+                self.cmd,
+                buffer.raw,
+                0,
+                buffer.size.max(4).next_multiple_of(4),
+                value,
+            )
         };
     }
 

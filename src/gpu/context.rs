@@ -11,7 +11,7 @@ use super::{
     debug::{self, ValidationLog},
     features,
     instance::{create_instance, load_entry, ContextOptions},
-    memory::DeletionQueue,
+    retire::DeletionQueue,
     submit::Timeline,
     GpuError, VkResultExt,
 };

@@ -8,7 +8,7 @@
 use ash::vk;
 
 use super::{
-    memory::{RetireOnDrop, Retired},
+    retire::{RetireOnDrop, Retired},
     submit::{allocate_command_buffer, transient_command_pool, transient_descriptor_pool},
     Context, GpuError, Profiler, Recorder, ScopeTiming, SubmissionId, VkResultExt,
 };

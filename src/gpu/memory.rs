@@ -1,40 +1,17 @@
-//! Named buffers and images on gpu-allocator memory, and deferred destruction: a dropped buffer or image (or
-//! pipeline, layout, sampler or pool, through [`RetireOnDrop`]) is freed only after the GPU has finished every
-//! submission made before it was dropped, and the submission of any recording open when it was dropped (Granite's
-//! per-frame lists, keyed here by timeline-semaphore value). Dropping is retiring, so none can leak by being
-//! forgotten, and no owner calls `destroy`.
+//! Named buffers and images on gpu-allocator memory. Dropping one retires it (retire.rs): it is freed, or kept
+//! for a later request of the same shape, once the GPU is done with it.
 
-use std::sync::{atomic::AtomicU64, Arc, Mutex};
+use std::sync::Arc;
 
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 pub use gpu_allocator::MemoryLocation;
 
 use super::{
     access::{self, Access},
+    retire::{BufferMemory, BufferShape, DeletionQueue, ImageMemory, ImageShape, Retired},
     Context, GpuError, VkResultExt,
 };
-
-/// GPU objects retired when their owner drops (see [`Context::retire_on_drop`]).
-pub(super) struct RetireOnDrop {
-    items: Vec<Retired>,
-    deletion: Arc<DeletionQueue>,
-}
-
-impl RetireOnDrop {
-    /// Adds an object just created, so that a failure further on retires it with the rest.
-    pub(super) fn push(&mut self, item: Retired) {
-        self.items.push(item);
-    }
-}
-
-impl Drop for RetireOnDrop {
-    fn drop(&mut self) {
-        for item in self.items.drain(..) {
-            self.deletion.retire(item);
-        }
-    }
-}
 
 /// A buffer request. `name` goes to the debug-utils object name and to the allocation.
 #[derive(Clone, Debug)]
@@ -46,18 +23,25 @@ pub struct BufferDesc<'a> {
     pub location: MemoryLocation,
 }
 
+/// A buffer: `size` bytes as requested, in a Vulkan buffer of its shape's capacity (which may be larger).
 pub struct Buffer {
     pub(super) raw: vk::Buffer,
     pub size: u64,
     pub name: String,
     allocation: Option<Allocation>,
+    shape: BufferShape,
     deletion: Arc<DeletionQueue>,
 }
 
 impl Drop for Buffer {
     fn drop(&mut self) {
-        self.deletion
-            .retire(Retired::Buffer(self.raw, self.allocation.take()));
+        if let Some(allocation) = self.allocation.take() {
+            self.deletion.retire(Retired::Buffer(BufferMemory {
+                raw: self.raw,
+                allocation,
+                shape: self.shape,
+            }));
+        }
     }
 }
 
@@ -122,22 +106,29 @@ pub struct Image {
     pub layers: u32,
     pub format: vk::Format,
     pub name: String,
-    usage: vk::ImageUsageFlags,
     allocation: Option<Allocation>,
+    shape: ImageShape,
     deletion: Arc<DeletionQueue>,
 }
 
 impl Drop for Image {
     fn drop(&mut self) {
-        self.deletion
-            .retire(Retired::Image(self.raw, self.view, self.allocation.take()));
+        if let Some(allocation) = self.allocation.take() {
+            self.deletion.retire(Retired::Image(ImageMemory {
+                raw: self.raw,
+                view: self.view,
+                allocation,
+                shape: self.shape,
+            }));
+        }
     }
 }
 
 impl Image {
     /// Whether shaders read or write it (storage or sampled usage): such images stay in GENERAL (gpu/access.rs).
     pub fn shader_visible(&self) -> bool {
-        self.usage
+        self.shape
+            .usage
             .intersects(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED)
     }
 
@@ -150,148 +141,24 @@ impl Image {
     }
 }
 
+/// The least capacity of a buffer: the frame loop's many small buffers (staging, per-dispatch inputs, masks) all
+/// take this one shape, so any of them serves any other once retired.
+const MIN_CAPACITY: u64 = 64 << 10;
+
+/// The capacity of a buffer made for a request of `size` bytes: at least [`MIN_CAPACITY`], and above it rounded up
+/// to an eighth of the power of two below (at most 12.5 % more), so that requests of nearby sizes share a shape.
+fn capacity_class(size: u64) -> u64 {
+    let size = size.max(MIN_CAPACITY);
+    let step = (1u64 << (63 - size.leading_zeros())) / 8;
+    size.div_ceil(step) * step
+}
+
 /// The aspect of an image of `format`: depth for the depth format this renderer uses, colour otherwise.
 fn aspect(format: vk::Format) -> vk::ImageAspectFlags {
     if format == vk::Format::D32_SFLOAT {
         vk::ImageAspectFlags::DEPTH
     } else {
         vk::ImageAspectFlags::COLOR
-    }
-}
-
-/// A GPU object waiting to be destroyed.
-pub(super) enum Retired {
-    Buffer(vk::Buffer, Option<Allocation>),
-    Image(vk::Image, vk::ImageView, Option<Allocation>),
-    Pool(vk::CommandPool),
-    DescriptorPool(vk::DescriptorPool),
-    QueryPool(vk::QueryPool),
-    Pipeline(vk::Pipeline, vk::PipelineLayout),
-    SetLayout(vk::DescriptorSetLayout),
-    Sampler(vk::Sampler),
-}
-
-/// Objects retired and when they may be destroyed.
-#[derive(Default)]
-struct Pending {
-    /// Each with the timeline value that must complete first.
-    tagged: Vec<(u64, Retired)>,
-    /// Retired while a recording was open: that recording may use them, and its submission's value is not known
-    /// yet, so they wait for every open recording to be submitted (or abandoned) and take the value then.
-    awaiting: Vec<Retired>,
-    /// Recordings begun and not yet submitted or dropped.
-    open: usize,
-}
-
-/// Resources waiting for the GPU to finish with them. With no recording open, what is retired waits for the last
-/// submission (`submitted`, shared with the timeline); with recordings open, for the last of their submissions:
-/// an object dropped after a command that uses it was recorded lives until that command has run.
-pub(crate) struct DeletionQueue {
-    pending: Mutex<Pending>,
-    submitted: Arc<AtomicU64>,
-}
-
-impl DeletionQueue {
-    pub(crate) fn new(submitted: Arc<AtomicU64>) -> Self {
-        Self {
-            pending: Mutex::new(Pending::default()),
-            submitted,
-        }
-    }
-
-    fn lock(&self) -> std::sync::MutexGuard<'_, Pending> {
-        self.pending.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    pub(super) fn retire(&self, item: Retired) {
-        let mut pending = self.lock();
-        if pending.open == 0 {
-            let after = self.submitted.load(std::sync::atomic::Ordering::Acquire);
-            pending.tagged.push((after, item));
-        } else {
-            pending.awaiting.push(item);
-        }
-    }
-
-    /// A recording began: what is retired from now on may be used by it.
-    pub(super) fn recording_opened(&self) {
-        self.lock().open += 1;
-    }
-
-    /// A recording was submitted (after the timeline took its value) or abandoned. When none is left open, what
-    /// waited for them takes the last submitted value.
-    pub(super) fn recording_closed(&self) {
-        let mut pending = self.lock();
-        pending.open = pending.open.saturating_sub(1);
-        if pending.open == 0 && !pending.awaiting.is_empty() {
-            let after = self.submitted.load(std::sync::atomic::Ordering::Acquire);
-            let awaiting = std::mem::take(&mut pending.awaiting);
-            pending
-                .tagged
-                .extend(awaiting.into_iter().map(|item| (after, item)));
-        }
-    }
-
-    /// How many objects wait to be destroyed.
-    pub(super) fn len(&self) -> usize {
-        let pending = self.lock();
-        pending.tagged.len() + pending.awaiting.len()
-    }
-
-    /// Frees every resource whose guarding submission has completed.
-    fn collect(&self, device: &ash::Device, allocator: &Mutex<Allocator>, completed: u64) {
-        let ready: Vec<Retired> = {
-            let mut pending = self.lock();
-            let (ready, keep): (Vec<_>, Vec<_>) =
-                pending.tagged.drain(..).partition(|(v, _)| *v <= completed);
-            pending.tagged = keep;
-            ready.into_iter().map(|(_, r)| r).collect()
-        };
-        if ready.is_empty() {
-            return;
-        }
-        let mut allocator = allocator.lock().unwrap_or_else(|e| e.into_inner());
-        for item in ready {
-            // SAFETY: the GPU finished every submission that could use these objects (timeline value reached).
-            unsafe {
-                match item {
-                    Retired::Buffer(b, a) => {
-                        device.destroy_buffer(b, None);
-                        if let Some(a) = a {
-                            let _ = allocator.free(a);
-                        }
-                    }
-                    Retired::Image(i, v, a) => {
-                        device.destroy_image_view(v, None);
-                        device.destroy_image(i, None);
-                        if let Some(a) = a {
-                            let _ = allocator.free(a);
-                        }
-                    }
-                    Retired::Pool(p) => device.destroy_command_pool(p, None),
-                    Retired::DescriptorPool(p) => device.destroy_descriptor_pool(p, None),
-                    Retired::QueryPool(q) => device.destroy_query_pool(q, None),
-                    Retired::Pipeline(p, l) => {
-                        device.destroy_pipeline(p, None);
-                        device.destroy_pipeline_layout(l, None);
-                    }
-                    Retired::SetLayout(l) => device.destroy_descriptor_set_layout(l, None),
-                    Retired::Sampler(x) => device.destroy_sampler(x, None),
-                }
-            }
-        }
-    }
-
-    /// Frees everything, awaiting or not (at the context's end, with the device idle).
-    pub(crate) fn flush_all(&self, device: &ash::Device, allocator: &Mutex<Allocator>) {
-        {
-            let mut pending = self.lock();
-            let awaiting = std::mem::take(&mut pending.awaiting);
-            pending
-                .tagged
-                .extend(awaiting.into_iter().map(|item| (0, item)));
-        }
-        self.collect(device, allocator, u64::MAX);
     }
 }
 
@@ -319,69 +186,135 @@ impl Context {
             })
     }
 
+    /// A buffer for `desc`: one kept for reuse if one fits (retire.rs), else a new one of the request's capacity
+    /// class.
     pub fn create_buffer(&self, desc: &BufferDesc) -> Result<Buffer, GpuError> {
+        let shape = BufferShape {
+            usage: access::buffer_usage(desc.uses),
+            location: desc.location,
+            capacity: capacity_class(desc.size),
+        };
+        let memory = match self.deletion.reuse_buffer(&shape) {
+            Some(memory) => memory,
+            None => self.new_buffer(desc.name, shape)?,
+        };
+        self.set_name(memory.raw, desc.name);
+        Ok(Buffer {
+            raw: memory.raw,
+            size: desc.size,
+            name: desc.name.to_string(),
+            allocation: Some(memory.allocation),
+            shape: memory.shape,
+            deletion: self.deletion.clone(),
+        })
+    }
+
+    fn new_buffer(&self, name: &str, shape: BufferShape) -> Result<BufferMemory, GpuError> {
         let info = vk::BufferCreateInfo::default()
-            .size(desc.size.max(4))
-            .usage(access::buffer_usage(desc.uses))
+            .size(shape.capacity)
+            .usage(shape.usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid create info; the buffer is destroyed through the deletion queue.
         let raw = unsafe { self.device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
         let requirements = unsafe { self.device.get_buffer_memory_requirements(raw) };
-        let allocation = match self.allocate(desc.name, requirements, desc.location, true) {
+        let allocation = match self.allocate(name, requirements, shape.location, true) {
             Ok(a) => a,
             Err(e) => {
                 unsafe { self.device.destroy_buffer(raw, None) };
                 return Err(e);
             }
         };
-        // SAFETY: fresh allocation satisfying the buffer's requirements.
-        unsafe {
-            self.device
-                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
-        }
-        .vk("vkBindBufferMemory")?;
-        self.set_name(raw, desc.name);
-        Ok(Buffer {
+        self.deletion.note_created();
+        let memory = BufferMemory {
             raw,
-            size: desc.size,
+            allocation,
+            shape,
+        };
+        // SAFETY: fresh allocation satisfying the buffer's requirements.
+        let bound = unsafe {
+            self.device.bind_buffer_memory(
+                raw,
+                memory.allocation.memory(),
+                memory.allocation.offset(),
+            )
+        };
+        if let Err(e) = bound.vk("vkBindBufferMemory") {
+            self.deletion.retire(Retired::Buffer(memory));
+            return Err(e);
+        }
+        Ok(memory)
+    }
+
+    /// An image for `desc`: one kept for reuse if its shape matches (its contents undefined, as a new one's), else
+    /// a new one.
+    pub fn create_image(&self, desc: &ImageDesc) -> Result<Image, GpuError> {
+        let shape = ImageShape {
+            extent: desc.extent,
+            format: desc.format,
+            layers: desc.layers,
+            array: desc.array,
+            usage: access::image_usage(desc.uses),
+        };
+        let memory = match self.deletion.reuse_image(&shape) {
+            Some(memory) => memory,
+            None => self.new_image(desc.name, shape)?,
+        };
+        self.set_name(memory.raw, desc.name);
+        self.set_name(memory.view, desc.name);
+        Ok(Image {
+            raw: memory.raw,
+            view: memory.view,
+            extent: desc.extent,
+            layers: desc.layers,
+            format: desc.format,
             name: desc.name.to_string(),
-            allocation: Some(allocation),
+            allocation: Some(memory.allocation),
+            shape,
             deletion: self.deletion.clone(),
         })
     }
 
-    pub fn create_image(&self, desc: &ImageDesc) -> Result<Image, GpuError> {
+    fn new_image(&self, name: &str, shape: ImageShape) -> Result<ImageMemory, GpuError> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
-            .format(desc.format)
+            .format(shape.format)
             .extent(vk::Extent3D {
-                width: desc.extent.width,
-                height: desc.extent.height,
+                width: shape.extent.width,
+                height: shape.extent.height,
                 depth: 1,
             })
             .mip_levels(1)
-            .array_layers(desc.layers)
+            .array_layers(shape.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(access::image_usage(desc.uses))
+            .usage(shape.usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid create info.
         let raw = unsafe { self.device.create_image(&info, None) }.vk("vkCreateImage")?;
         let requirements = unsafe { self.device.get_image_memory_requirements(raw) };
-        let allocation =
-            match self.allocate(desc.name, requirements, MemoryLocation::GpuOnly, false) {
-                Ok(a) => a,
-                Err(e) => {
-                    unsafe { self.device.destroy_image(raw, None) };
-                    return Err(e);
-                }
-            };
-        unsafe {
-            self.device
-                .bind_image_memory(raw, allocation.memory(), allocation.offset())
-        }
-        .vk("vkBindImageMemory")?;
-        let view_type = if desc.layers > 1 || desc.array {
+        let allocation = match self.allocate(name, requirements, MemoryLocation::GpuOnly, false) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { self.device.destroy_image(raw, None) };
+                return Err(e);
+            }
+        };
+        self.deletion.note_created();
+        let mut memory = ImageMemory {
+            raw,
+            view: vk::ImageView::null(),
+            allocation,
+            shape,
+        };
+        // SAFETY: fresh allocation satisfying the image's requirements.
+        let bound = unsafe {
+            self.device.bind_image_memory(
+                raw,
+                memory.allocation.memory(),
+                memory.allocation.offset(),
+            )
+        };
+        let view_type = if shape.layers > 1 || shape.array {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
             vk::ImageViewType::TYPE_2D
@@ -389,42 +322,28 @@ impl Context {
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(view_type)
-            .format(desc.format)
+            .format(shape.format)
             .subresource_range(
                 vk::ImageSubresourceRange::default()
-                    .aspect_mask(aspect(desc.format))
+                    .aspect_mask(aspect(shape.format))
                     .level_count(1)
-                    .layer_count(desc.layers),
+                    .layer_count(shape.layers),
             );
-        let view =
-            unsafe { self.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
-        self.set_name(raw, desc.name);
-        self.set_name(view, desc.name);
-        Ok(Image {
-            raw,
-            view,
-            extent: desc.extent,
-            layers: desc.layers,
-            format: desc.format,
-            name: desc.name.to_string(),
-            usage: access::image_usage(desc.uses),
-            allocation: Some(allocation),
-            deletion: self.deletion.clone(),
-        })
-    }
-
-    /// A guard that retires `items` (through the deletion queue, as a dropped buffer is) when it drops: the
-    /// owner of pipelines, layouts, samplers and pools holds one, and needs no `destroy` call.
-    pub(super) fn retire_on_drop(&self, items: Vec<Retired>) -> RetireOnDrop {
-        RetireOnDrop {
-            items,
-            deletion: self.deletion.clone(),
+        let view = bound.vk("vkBindImageMemory").and_then(|()| {
+            // SAFETY: the image is bound to memory.
+            unsafe { self.device.create_image_view(&view_info, None) }.vk("vkCreateImageView")
+        });
+        match view {
+            Ok(view) => {
+                memory.view = view;
+                Ok(memory)
+            }
+            Err(e) => {
+                // Destroying a null view is a no-op.
+                self.deletion.retire(Retired::Image(memory));
+                Err(e)
+            }
         }
-    }
-
-    /// Objects retired and not yet destroyed (the GPU may still use them).
-    pub fn retired_objects(&self) -> usize {
-        self.deletion.len()
     }
 
     /// How many buffers and images hold memory (live, or retired and not yet freed): for leak checks.
@@ -435,12 +354,5 @@ impl Context {
             .generate_report()
             .allocations
             .len()
-    }
-
-    /// Frees retired resources whose submissions have completed. Cheap; call once per frame.
-    pub fn collect_garbage(&self) {
-        let completed = self.timeline.completed(&self.device).unwrap_or(0);
-        self.deletion
-            .collect(&self.device, &self.allocator, completed);
     }
 }

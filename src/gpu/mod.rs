@@ -3,7 +3,7 @@
 //! One file per concern, as in wgpu-hal: [`access`] (the synchronisation vocabulary: every barrier names uses, not
 //! stage and access flags), [`instance`] (the loader, the instance and the options a context is made with), [`adapter`] (describing the
 //! devices and choosing one), [`context`] (device, queue, allocator), `debug` (validation messages, object names, labels),
-//! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images, deferred deletion),
+//! [`features`] (the one negotiated feature struct), [`memory`] (named buffers and images), [`retire`] (deferred deletion and reuse),
 //! [`commands`] (everything recorded into a command buffer: uploads, copies, barriers, dispatches, draws), [`submit`]
 //! (command buffers, timeline-semaphore submissions), [`frames`] (the ring of
 //! frame contexts that keeps frames in flight), [`bindless`] (the global descriptor-indexed set), [`pipeline`]
@@ -23,6 +23,7 @@ pub mod memory;
 pub mod overlay;
 pub mod pipeline;
 pub mod profiler;
+pub mod retire;
 pub mod submit;
 pub mod swapchain;
 

@@ -3,7 +3,7 @@
 use ash::vk;
 
 use super::{
-    memory::{RetireOnDrop, Retired},
+    retire::{RetireOnDrop, Retired},
     Context, GpuError, Image, VkResultExt,
 };
 

@@ -5,7 +5,7 @@
 use ash::vk;
 
 use super::{
-    memory::{RetireOnDrop, Retired},
+    retire::{RetireOnDrop, Retired},
     Context, GpuError, Recorder, VkResultExt,
 };
 

@@ -9,7 +9,7 @@ use std::sync::{
 
 use ash::vk;
 
-use super::{access::Access, memory::Retired, Buffer, Context, GpuError, VkResultExt};
+use super::{access::Access, retire::Retired, Buffer, Context, GpuError, VkResultExt};
 
 /// The timeline semaphore that every submission signals.
 pub(crate) struct Timeline {
@@ -197,9 +197,10 @@ impl<'a> Recorder<'a> {
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
             .map(|b| {
+                // The requested size, not the whole buffer: a reused buffer may be larger (retire.rs).
                 [vk::DescriptorBufferInfo::default()
                     .buffer(b.raw)
-                    .range(vk::WHOLE_SIZE)]
+                    .range(b.size.max(4))]
             })
             .collect();
         let writes: Vec<_> = infos
