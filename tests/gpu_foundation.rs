@@ -5,11 +5,62 @@ mod common;
 use riverplanet::{
     gpu::{
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
-        Access, BufferDesc, Extent2D, Format, ImageDesc, ImageUse, MemoryLocation, Profiler,
-        Recorder,
+        Access, Buffer, BufferDesc, Context, Extent2D, Format, ImageDesc, ImageUse, MemoryLocation,
+        Profiler, Recorder,
     },
     shaders,
 };
+
+/// The fill shader's pieces: an output buffer of `count` floats, a host-visible buffer to read it back into, its
+/// set layout and pipeline (`out[i] = i * a + b`, push constants a, b, count).
+struct Fill {
+    out: Buffer,
+    readback: Buffer,
+    sets: BufferSetLayout,
+    pipeline: ComputePipeline,
+}
+
+impl Fill {
+    fn new(ctx: &Context, count: u32) -> Self {
+        let size = count as u64 * 4;
+        let buffer = |name, uses, location| {
+            ctx.create_buffer(&BufferDesc {
+                name,
+                size,
+                uses,
+                location,
+            })
+            .unwrap()
+        };
+        let sets = BufferSetLayout::new(ctx, 1, "fill set").unwrap();
+        let pipeline = ComputePipeline::new(
+            ctx,
+            &ComputeDesc {
+                name: "fill",
+                spirv: shaders::FILL_COMP,
+                set_layouts: &[sets.layout],
+                push_constant_bytes: 12,
+                specialization: &[],
+                full_subgroups: None,
+            },
+        )
+        .unwrap();
+        Self {
+            out: buffer(
+                "fill output",
+                &[Access::ComputeWrite, Access::TransferRead],
+                MemoryLocation::GpuOnly,
+            ),
+            readback: buffer(
+                "fill readback",
+                &[Access::TransferWrite, Access::HostRead],
+                MemoryLocation::GpuToCpu,
+            ),
+            sets,
+            pipeline,
+        }
+    }
+}
 
 /// Issue 37: a pipeline, its set layout and the buffer it writes, dropped after a dispatch that uses them was
 /// recorded and before that recording is submitted, live until the dispatch has run: a garbage collection meanwhile
@@ -21,36 +72,12 @@ fn objects_dropped_while_a_recording_uses_them_live_until_it_has_run() {
     let ctx = &own;
     ctx.run_and_wait("first submission", |_| Ok(())).unwrap();
     const COUNT: u32 = 256;
-    let size = COUNT as u64 * 4;
-    let out = ctx
-        .create_buffer(&BufferDesc {
-            name: "dropped output",
-            size,
-            uses: &[Access::ComputeWrite, Access::TransferRead],
-            location: MemoryLocation::GpuOnly,
-        })
-        .unwrap();
-    let readback = ctx
-        .create_buffer(&BufferDesc {
-            name: "kept readback",
-            size,
-            uses: &[Access::TransferWrite, Access::HostRead],
-            location: MemoryLocation::GpuToCpu,
-        })
-        .unwrap();
-    let sets = BufferSetLayout::new(ctx, 1, "dropped set layout").unwrap();
-    let pipeline = ComputePipeline::new(
-        ctx,
-        &ComputeDesc {
-            name: "dropped fill",
-            spirv: shaders::FILL_COMP,
-            set_layouts: &[sets.layout],
-            push_constant_bytes: 12,
-            specialization: &[],
-            full_subgroups: None,
-        },
-    )
-    .unwrap();
+    let Fill {
+        out,
+        readback,
+        sets,
+        pipeline,
+    } = Fill::new(ctx, COUNT);
     let push: [u32; 3] = [2.0f32.to_bits(), 1.0f32.to_bits(), COUNT];
     let mut rec = Recorder::begin(ctx, "drop while recorded").unwrap();
     let set = rec.buffer_set(&sets, &[&out]).unwrap();
@@ -61,7 +88,7 @@ fn objects_dropped_while_a_recording_uses_them_live_until_it_has_run() {
         [COUNT.div_ceil(64), 1, 1],
     );
     rec.buffer_barrier(&out, &[Access::ComputeWrite], &[Access::TransferRead]);
-    rec.copy_buffer(&out, &readback, size);
+    rec.copy_buffer(&out, &readback, COUNT as u64 * 4);
     let before = ctx.retired_objects();
     drop(pipeline);
     drop(sets);
@@ -92,35 +119,12 @@ fn compute_dispatch_reads_back_and_is_timed() {
     let Some(ctx) = common::gpu() else { return };
     const COUNT: u32 = 1000;
     let size = COUNT as u64 * 4;
-    let out = ctx
-        .create_buffer(&BufferDesc {
-            name: "fill output",
-            size,
-            uses: &[Access::ComputeWrite, Access::TransferRead],
-            location: MemoryLocation::GpuOnly,
-        })
-        .unwrap();
-    let readback = ctx
-        .create_buffer(&BufferDesc {
-            name: "fill readback",
-            size,
-            uses: &[Access::TransferWrite, Access::HostRead],
-            location: MemoryLocation::GpuToCpu,
-        })
-        .unwrap();
-    let sets = BufferSetLayout::new(ctx, 1, "fill set").unwrap();
-    let pipeline = ComputePipeline::new(
-        ctx,
-        &ComputeDesc {
-            name: "fill",
-            spirv: shaders::FILL_COMP,
-            set_layouts: &[sets.layout],
-            push_constant_bytes: 12,
-            specialization: &[],
-            full_subgroups: None,
-        },
-    )
-    .unwrap();
+    let Fill {
+        out,
+        readback,
+        sets,
+        pipeline,
+    } = Fill::new(ctx, COUNT);
     let mut profiler = Profiler::new(ctx, 4, "fill timestamps").unwrap();
 
     let push: [u32; 3] = [0.5f32.to_bits(), 3.0f32.to_bits(), COUNT];

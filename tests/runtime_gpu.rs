@@ -14,10 +14,7 @@ use riverplanet::{
         KernelParams, PatchJob,
     },
     planet::cube::PatchId,
-    render::{
-        target::{Offscreen, COLOR_FORMAT, DEPTH_FORMAT},
-        Renderer,
-    },
+    render::target::Offscreen,
     river::samples::{patch_samples, PatchFrame},
     world::World,
 };
@@ -109,24 +106,23 @@ fn river_data_is_identical_alone_in_a_batch_and_after_recomputing() {
     common::assert_no_validation_errors(ctx);
 }
 
-#[test]
-fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
-    let Some(ctx) = common::gpu() else { return };
-    let world = world();
+/// `world`'s configuration with a cache of 96 patches, 16 new ones a frame and ten times the detail: a flight
+/// fills the cache within a few dozen frames and evicts from then on.
+fn small_cache(world: &World) -> Config {
     let mut config = world.config.clone();
     config.rendering.max_resident_patches = 96;
     config.rendering.new_patches_per_frame = 16;
     config.rendering.level_of_detail_switch_factor *= 10.0;
+    config
+}
+
+#[test]
+fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = world();
+    let config = small_cache(world);
     let target = Offscreen::new(ctx, 96, 64).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
+    let mut renderer = common::renderer_with(ctx, world, &config);
     let frames = 200;
     let flight = Flight::new(world, frames, 25.0, 1.5);
     let mut evicted = 0;
@@ -160,20 +156,9 @@ fn a_warm_frame_loop_creates_no_buffer_or_image() {
     let Some(own) = common::own_gpu() else { return };
     let ctx = &own;
     let world = world();
-    let mut config = world.config.clone();
-    config.rendering.max_resident_patches = 96;
-    config.rendering.new_patches_per_frame = 16;
-    config.rendering.level_of_detail_switch_factor *= 10.0;
+    let config = small_cache(world);
     let target = Offscreen::new(ctx, 96, 64).unwrap();
-    let mut renderer = Renderer::new(
-        ctx,
-        &world.planet,
-        &world.network,
-        &config,
-        COLOR_FORMAT,
-        DEPTH_FORMAT,
-    )
-    .unwrap();
+    let mut renderer = common::renderer_with(ctx, world, &config);
     let (frames, warm) = (100u32, 50usize);
     let flight = Flight::new(world, frames, 25.0, 1.5);
     let mut evicted = 0;
