@@ -16,11 +16,16 @@ fn temp_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
-/// Runs `export rivers` with `args` into DIR/rivers.geojson and reads the file back.
+/// Runs `export rivers` of seed 1 with `args` into DIR/rivers.geojson and reads the file back.
 fn export_rivers(name: &str, args: &[&str]) -> Value {
+    export_rivers_of(name, 1, args)
+}
+
+/// As [`export_rivers`], of `seed`.
+fn export_rivers_of(name: &str, seed: u32, args: &[&str]) -> Value {
     let out = temp_dir(name).join("rivers.geojson");
     let run = riverplanet()
-        .args(["export", "rivers", "--seed", "1"])
+        .args(["export", "rivers", "--seed", &seed.to_string()])
         .args(args)
         .arg("--out")
         .arg(&out)
@@ -30,7 +35,7 @@ fn export_rivers(name: &str, args: &[&str]) -> Value {
     assert!(run.status.success(), "{stderr}");
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(
-        stdout.contains("seed: 1"),
+        stdout.contains(&format!("seed: {seed}")),
         "the seed is not printed: {stdout}"
     );
     serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap()
@@ -163,6 +168,17 @@ fn the_drainage_rivers_export_as_rfc_7946_with_bed_heights_and_lakes() {
     assert!(
         features.iter().any(|f| f["properties"]["lake"].is_u64()),
         "no lake"
+    );
+}
+
+/// Issue 38: seed 606's rivers pass through points on the antimeridian, where a longitude's last bits put a point
+/// on one side and its repetition on the other; rounded, they made a segment from 180 to -180 across the map.
+#[test]
+fn rivers_through_a_point_on_the_antimeridian_never_span_the_map() {
+    let collection = export_rivers_of("antimeridian", 606, &[]);
+    assert!(
+        assert_rfc7946(&collection) > 0,
+        "no river of seed 606 is cut"
     );
 }
 

@@ -64,8 +64,27 @@ pub fn split_at_antimeridian(points: &[(DVec3, Option<f64>)]) -> Vec<Vec<Vec<f64
             .push(position(lon, lat, height));
         previous = Some((lon, lat, height));
     }
-    parts.retain(|part| part.len() >= 2);
     parts
+        .into_iter()
+        .flat_map(cut_jumps)
+        .filter(|part| part.iter().any(|p| p != &part[0]))
+        .collect()
+}
+
+/// `part` cut wherever two neighbouring positions lie more than half the world apart in longitude. Only positions on
+/// the antimeridian can: a point on it whose longitude's last bits put it on one side, then the other, rounds to 180
+/// and then -180 at one latitude (seed 606's rivers did). Parts of fewer than two positions are left out.
+fn cut_jumps(part: Vec<Vec<f64>>) -> Vec<Vec<Vec<f64>>> {
+    let mut out: Vec<Vec<Vec<f64>>> = vec![Vec::new()];
+    for p in part {
+        let current = out.last_mut().expect("one part at least");
+        if current.last().is_some_and(|q| (p[0] - q[0]).abs() > 180.0) {
+            out.push(Vec::new());
+        }
+        out.last_mut().expect("one part at least").push(p);
+    }
+    out.retain(|part| part.len() >= 2);
+    out
 }
 
 /// A LineString, or a MultiLineString where the path crosses the antimeridian.
@@ -200,6 +219,42 @@ mod tests {
         }
         let small = polygon_geometry(&[at(0.0, 0.0), at(1.0, 0.0), at(1.0, 1.0), at(0.0, 0.0)]);
         assert_eq!(small["type"], "Polygon");
+    }
+
+    #[test]
+    fn positions_on_both_sides_of_the_antimeridian_never_make_one_segment() {
+        let part = vec![
+            vec![-179.9, 10.0],
+            vec![-180.0, 10.0],
+            vec![180.0, 10.0],
+            vec![-180.0, 10.0],
+            vec![-180.0, 10.0],
+            vec![179.9, 10.0],
+            vec![179.8, 10.1],
+        ];
+        let parts = cut_jumps(part);
+        assert_eq!(
+            parts,
+            vec![
+                vec![vec![-179.9, 10.0], vec![-180.0, 10.0]],
+                vec![vec![-180.0, 10.0], vec![-180.0, 10.0]],
+                vec![vec![179.9, 10.0], vec![179.8, 10.1]],
+            ]
+        );
+        // A path through a point on the antimeridian, the point repeated: every part spans a distance, none the map.
+        let points = [
+            (at(-179.5, 5.0), None),
+            (at(180.0, 5.0), None),
+            (at(-180.0, 5.0), None),
+            (at(180.0, 5.0), None),
+            (at(179.5, 5.0), None),
+        ];
+        for part in split_at_antimeridian(&points) {
+            assert!(part.iter().any(|p| p != &part[0]), "{part:?}");
+            for pair in part.windows(2) {
+                assert!((pair[1][0] - pair[0][0]).abs() <= 180.0, "{part:?}");
+            }
+        }
     }
 
     #[test]
