@@ -500,7 +500,9 @@ fn diamond_square(
 fn measure(heights: &FaceLattice, sea_level: f32) -> (f64, f32, f32) {
     let side = heights.side();
     let c = heights.cells;
-    let (land, total, lo, hi) = (0..FACES * side)
+    // Rows in parallel, summed in row order: a parallel reduction adds in an order that depends on the thread
+    // count, and the land share then differed in its last digits between 1 and 2 threads.
+    let rows: Vec<(f64, f64, f32, f32)> = (0..FACES * side)
         .into_par_iter()
         .map(|row| {
             let (face, j) = (row / side, (row % side) as u32);
@@ -517,9 +519,11 @@ fn measure(heights: &FaceLattice, sea_level: f32) -> (f64, f32, f32) {
             }
             acc
         })
-        .reduce(
-            || (0.0, 0.0, f32::MAX, f32::MIN),
-            |a, b| (a.0 + b.0, a.1 + b.1, a.2.min(b.2), a.3.max(b.3)),
-        );
+        .collect();
+    let (land, total, lo, hi) = rows
+        .into_iter()
+        .fold((0.0, 0.0, f32::MAX, f32::MIN), |a, b| {
+            (a.0 + b.0, a.1 + b.1, a.2.min(b.2), a.3.max(b.3))
+        });
     (land / total, lo, hi)
 }
