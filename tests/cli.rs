@@ -952,3 +952,22 @@ fn generate_makes_the_same_planet_on_any_number_of_threads() {
     );
     assert!(one.2 == three.2, "the faces differ between 1 and 3 threads");
 }
+
+/// Issue 38, finding 14: `view` without a display says so before any work: no planet is made (its seed line is
+/// printed once it is), where before it generated a whole planet first.
+#[test]
+fn view_without_a_display_says_so_before_making_a_planet() {
+    let run = riverplanet()
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .args(["view", "--seed", "1"])
+        .output()
+        .unwrap();
+    assert_refused(&run, 1, &["cannot open a window", "DISPLAY"]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        !stdout.contains("seed:"),
+        "a planet was made first: {stdout}"
+    );
+}

@@ -185,6 +185,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
         check_camera(eye, args.look_at, &config)?;
     }
     riverplanet::gpu::adapter::check_can_draw(options)?;
+    let event_loop = riverplanet::render::viewer::event_loop()?;
     let seed = planet_seed(args.planet.seed, &config);
     let world = riverplanet::world::World::build(&config, seed)?;
     let (eye, look_at) = match args.eye {
@@ -199,6 +200,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
         )),
     };
     riverplanet::render::viewer::run(
+        event_loop,
         &world,
         options,
         riverplanet::render::viewer::ViewerOptions {

@@ -85,13 +85,19 @@ pub struct ViewerOptions {
     pub water_in_mesh: bool,
 }
 
-/// Opens the viewer and runs until the window closes (or `frames` are done).
+/// The display's event loop, or why there is none. Made before any other work, so that `view` without a display
+/// says so at once instead of after generating a planet.
+pub fn event_loop() -> Result<EventLoop<()>, ViewerError> {
+    EventLoop::new().map_err(|e| ViewerError::Window(e.to_string()))
+}
+
+/// Opens the viewer on `event_loop` and runs until the window closes (or `frames` are done).
 pub fn run(
+    event_loop: EventLoop<()>,
     world: &World,
     context_options: &ContextOptions,
     options: ViewerOptions,
 ) -> Result<(), ViewerError> {
-    let event_loop = EventLoop::new().map_err(|e| ViewerError::Window(e.to_string()))?;
     let display = event_loop
         .display_handle()
         .map_err(|e| ViewerError::Window(e.to_string()))?
