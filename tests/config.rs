@@ -120,10 +120,34 @@ fn vertices_must_be_power_of_two_plus_one() {
 }
 
 #[test]
-fn radius_must_be_positive() {
-    for bad in ["0", "-5.0f", "nan", "inf"] {
+fn radius_must_lie_between_1_and_1e8() {
+    for bad in ["0", "-5.0f", "nan", "inf", "0.5", "1e-45", "2e8"] {
         let msg = error_of(&with("planet-attributes", "radius", bad));
-        assert!(msg.contains("<radius>") && msg.contains("> 0"), "{msg}");
+        assert!(
+            msg.contains("<radius>") && msg.contains("[1, 100000000]"),
+            "{msg}"
+        );
+    }
+}
+
+/// Issue 38, finding 6: every size is bounded by the planet's: heights to a quarter of the radius, the air to the
+/// radius, the widest river and the influence distance to a quarter of it, the source area to the sphere's.
+#[test]
+fn sizes_beyond_the_planets_are_refused_by_element() {
+    for (section, element, value) in [
+        ("planet-attributes", "max-mountain-height", "3e38"),
+        ("planet-attributes", "ocean-height", "-1e30"),
+        ("planet-attributes", "detail-amplitude", "1e30"),
+        ("planet-attributes", "atmosphere-height", "1e5"),
+        ("river-attributes", "basin-depth", "1e30"),
+        ("river-attributes", "influence-distance", "1e30"),
+        ("river-attributes", "source-area", "1e20"),
+    ] {
+        let msg = error_of(&with(section, element, value));
+        assert!(
+            msg.contains(&format!("<{element}>")) && msg.contains("radius 1024"),
+            "{msg}"
+        );
     }
 }
 
@@ -191,11 +215,11 @@ fn unreadable_file_names_the_path() {
 #[test]
 fn missing_elements_take_defaults() {
     let c = Config::parse(
-        "<planet><planet-attributes><radius>10</radius></planet-attributes></planet>",
+        "<planet><planet-attributes><radius>1000</radius></planet-attributes></planet>",
         "t",
     )
     .unwrap();
-    assert_eq!(c.planet.radius, 10.0);
+    assert_eq!(c.planet.radius, 1000.0);
     assert_eq!(c.rendering.vertices, 33);
 }
 
@@ -209,22 +233,19 @@ fn seed_accepts_minus_one_and_rejects_below() {
 
 #[test]
 fn numbers_beyond_single_precision_are_refused_by_element() {
-    for (element, value) in [
-        ("radius", "1e39"),
-        ("radius", "1e-50"),
-        ("influence-distance", "4e38"),
+    // Issue 38, finding 7: 1e-50 became 0 and 1e-45 a denormal.
+    for (section, element, value) in [
+        ("planet-attributes", "sea-level-height", "1e39"),
+        ("planet-attributes", "sea-level-height", "1e-50"),
+        ("river-attributes", "influence-distance", "4e38"),
+        ("river-attributes", "basin-depth", "1e-45"),
     ] {
-        let section = if element == "radius" {
-            "planet-attributes"
-        } else {
-            "river-attributes"
-        };
         let message = error_of(&with(section, element, value));
         assert!(
             message.contains(element) && message.contains(value),
             "{message}"
         );
-        assert!(message.contains("single precision"), "{message}");
+        assert!(message.contains("single-precision"), "{message}");
     }
 }
 

@@ -48,6 +48,13 @@ impl Range {
     }
 }
 
+/// Whether `x` holds as an f32: 1e39 would become infinity, 1e-50 zero and 1e-45 a denormal (whose arithmetic loses
+/// precision and, on some GPUs, is flushed to zero).
+fn single_precision(x: f64) -> bool {
+    let y = x as f32;
+    y.is_finite() && (x == 0.0 || y.is_normal())
+}
+
 /// One element of a section of type `S`: its name, what it accepts, and the field it sets.
 enum Param<S> {
     /// A number in a range, held in single precision.
@@ -91,7 +98,7 @@ fn choose<T: Named>(text: &str, field: &mut T) -> Result<(), String> {
 
 /// `<planet-attributes>`.
 const PLANET: &[Param<PlanetConfig>] = &[
-    Param::Number("radius", Range::Positive, |c| &mut c.radius),
+    Param::Number("radius", Range::Closed(1.0, 1e8), |c| &mut c.radius),
     Param::Whole("continents", 1, 64, |c| &mut c.continents),
     Param::Number("landmass-percentage", Range::Open(0.0, 100.0), |c| {
         &mut c.landmass_percentage
@@ -343,16 +350,13 @@ fn read_section<S>(
         let value = clean(text);
         match param {
             Param::Number(_, range, field) => match value.parse::<f64>() {
-                // The value must hold as an f32 too: 1e39 would become infinity and 1e-50 zero.
-                Ok(x) if range.contains(x) && range.contains(x as f32 as f64) => {
-                    *field(target) = x as f32
-                }
+                Ok(x) if range.contains(x) && single_precision(x) => *field(target) = x as f32,
                 Ok(x) if range.contains(x) => {
                     return Err(error(
                         wanted,
                         text,
                         format!(
-                            "{range}, within single precision (about 1.2e-38 to 3.4e38 in size)"
+                            "{range}, and 0 or a normal single-precision number (about 1.2e-38 to 3.4e38 in size)"
                         ),
                     ))
                 }
@@ -467,6 +471,104 @@ impl Config {
         Ok(config)
     }
 
+    /// Sizes against the radius: heights beyond a quarter of the radius fold the planet onto itself, rivers wider than
+    /// that or draining more than the sphere mean nothing, and air above the radius leaves the f32 shell maths. Each
+    /// element alone passed its own range (1e30 included) before these rules.
+    fn check_scales(&self, path: &str) -> Result<(), ConfigError> {
+        let (planet, river) = (&self.planet, &self.river);
+        let radius = planet.radius as f64;
+        let quarter = radius / 4.0;
+        let widest = river.starting_width as f64 * (river.ending_factor as f64).max(1.0);
+        let sphere = 4.0 * std::f64::consts::PI * radius * radius;
+        let rules: [(&str, f64, f64, String); 12] = [
+            (
+                "sea-level-height",
+                planet.sea_level_height.abs() as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "continent-height",
+                planet.continent_height.abs() as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "ocean-height",
+                planet.ocean_height.abs() as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "max-mountain-height",
+                planet.max_mountain_height as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "detail-amplitude",
+                planet.detail_amplitude as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "atmosphere-height",
+                planet.atmosphere_height as f64,
+                radius,
+                "the radius".into(),
+            ),
+            (
+                "basin-depth",
+                river.basin_depth as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "basin-water-offset",
+                river.basin_water_offset as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "lake-depth",
+                river.lake_depth as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "influence-distance",
+                river.influence_distance as f64,
+                quarter,
+                "a quarter of the radius".into(),
+            ),
+            (
+                "ending-factor",
+                widest,
+                quarter,
+                "a quarter of the radius as the widest river (starting-width x ending-factor)"
+                    .into(),
+            ),
+            (
+                "source-area",
+                river.source_area as f64,
+                sphere,
+                "the sphere's area (4 pi radius^2)".into(),
+            ),
+        ];
+        for (element, size, most, what) in rules {
+            if size > most {
+                return Err(ConfigError::Value {
+                    path: path.to_string(),
+                    element: element.to_string(),
+                    // Debug writes 3e38 as such, Display as 39 digits.
+                    value: format!("{:?}", size as f32),
+                    expected: format!("must be at most {what}: {most} with radius {radius}"),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The rules between elements.
     fn check(&self, path: &str) -> Result<(), ConfigError> {
         let error = |element: &str, value: String, expected: String| ConfigError::Value {
@@ -519,6 +621,7 @@ impl Config {
                 format!("must not exceed starting-width ({})", river.starting_width),
             ));
         }
+        self.check_scales(path)?;
         // Lattice keys are 32-bit signed integers on the GPU (planet::detail): the finest lattice must keep its
         // cells per face edge, with the border, below 2^31.
         let deepest = MAX_LATTICE_CELLS.ilog2() - (rendering.vertices - 1).ilog2();
