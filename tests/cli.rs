@@ -971,3 +971,86 @@ fn view_without_a_display_says_so_before_making_a_planet() {
         "a planet was made first: {stdout}"
     );
 }
+
+/// Issue 38, finding 8: a recorded camera is checked as `--eye` is (inside the planet, or further than 1e4 radii,
+/// is refused) in `render --path` and in every frame of `bench flight --path`; an eye of 1e39 and a `--time` beyond
+/// the water clock's precision are refused too, all before any work and with the argument named; a path file of
+/// more frames than an hour's is refused by its count.
+#[test]
+fn cameras_out_of_the_planets_reach_are_refused_before_any_work() {
+    let dir = temp_dir("camera-bounds");
+    let out = dir.join("never.png");
+    let frame = |position: [f64; 3]| {
+        serde_json::json!({ "time": 0.0, "position": position, "forward": [1.0, 0.0, 0.0],
+                            "up": [0.0, 0.0, 1.0], "altitude": 10.0 })
+    };
+    let path_of = |name: &str, frames: Vec<serde_json::Value>| {
+        let file = dir.join(name);
+        let path = serde_json::json!({ "seed": 1, "frames": frames });
+        std::fs::write(&file, serde_json::to_vec(&path).unwrap()).unwrap();
+        file
+    };
+    let centre = path_of("centre.json", vec![frame([0.0, 0.0, 0.0])]);
+    let later_inside = path_of(
+        "later.json",
+        vec![frame([0.0, 3000.0, 0.0]), frame([0.0, 100.0, 0.0])],
+    );
+    let far = ["--eye", "1e39,0,0", "--look-at", "0,0,0"];
+    let cases: Vec<(Vec<std::ffi::OsString>, &[&str])> = vec![
+        (
+            ["render", "--out"]
+                .map(Into::into)
+                .into_iter()
+                .chain([out.clone().into()])
+                .chain(far.map(Into::into))
+                .collect(),
+            &["--eye", "radii"],
+        ),
+        (
+            ["render", "--eye", "0,0,3000", "--time", "1e39", "--out"]
+                .map(Into::into)
+                .into_iter()
+                .chain([out.clone().into()])
+                .collect(),
+            &["--time", "[0, 1000000]"],
+        ),
+        (
+            ["render", "--out"]
+                .map(Into::into)
+                .into_iter()
+                .chain([out.clone().into()])
+                .chain(["--path".into(), centre.clone().into()])
+                .collect(),
+            &["--path", "inside the planet"],
+        ),
+        (
+            ["bench", "flight", "--frames", "2", "--json"]
+                .map(Into::into)
+                .into_iter()
+                .chain([
+                    dir.join("never.json").into(),
+                    "--path".into(),
+                    later_inside.clone().into(),
+                ])
+                .collect(),
+            &["--path", "frame 1", "inside the planet"],
+        ),
+    ];
+    for (args, culprits) in cases {
+        let run = riverplanet().args(&args).output().unwrap();
+        assert_refused(&run, 2, culprits);
+    }
+    assert!(!out.exists() && !dir.join("never.json").exists());
+    let long = path_of(
+        "long.json",
+        vec![frame([0.0, 3000.0, 0.0]); riverplanet::runtime::camera_path::MAX_FRAMES + 1],
+    );
+    let run = riverplanet()
+        .args(["render", "--out"])
+        .arg(&out)
+        .arg("--path")
+        .arg(&long)
+        .output()
+        .unwrap();
+    assert_refused(&run, 2, &["--path", "frames, at most"]);
+}

@@ -132,6 +132,10 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                     riverplanet::runtime::camera_path::CameraPath::load(&p).map_err(crate::usage)
                 })
                 .transpose()?;
+            for (k, frame) in path.iter().flat_map(|p| p.frames.iter().enumerate()) {
+                super::render::check_path_frame(frame, &config)
+                    .map_err(|e| crate::usage(format!("--path: frame {k}: {e}")))?;
+            }
             let frames = path.as_ref().map_or(frames, |p| p.frames.len() as u32);
             // Before any work: a device that cannot draw is refused here.
             let ctx = Context::new(&ContextOptions {

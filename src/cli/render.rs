@@ -15,8 +15,23 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         Some(file) => Some(path_frame(file, args.path_frame)?),
         None => None,
     };
-    if args.preset.is_none() && recorded.is_none() {
-        check_camera(args.eye, args.look_at, &config)?;
+    match &recorded {
+        Some(frame) => check_path_frame(frame, &config).map_err(|e| {
+            usage(format!(
+                "--path {}: {e}",
+                args.path
+                    .as_ref()
+                    .map_or(String::new(), |p| p.display().to_string())
+            ))
+        })?,
+        None if args.preset.is_none() => check_camera(args.eye, args.look_at, &config)?,
+        None => {}
+    }
+    if !(0.0..=MAX_TIME_S).contains(&args.time) {
+        return Err(usage(format!(
+            "--time {} must be in [0, {MAX_TIME_S}] seconds (the water's clock is single precision)",
+            args.time
+        )));
     }
     if let Some(up) = args.up {
         let forward = (args.look_at - args.eye).normalize_or_zero();
@@ -136,23 +151,48 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     Ok(())
 }
 
-/// Refuses a camera inside the planet (below half its radius: the terrain never reaches there) or one that looks
-/// at itself, before any work.
+/// The latest `--time` (seconds): beyond it the water's f32 clock moves in steps of a frame or more.
+const MAX_TIME_S: f64 = 1e6;
+
+/// Refuses a camera inside the planet (below half its radius: the terrain never reaches there), further than
+/// [`MAX_CAMERA_RADII`] radii from its centre, or one that looks at itself, before any work.
 fn check_camera(
     eye: glam::DVec3,
     look_at: glam::DVec3,
     config: &riverplanet::config::Config,
 ) -> anyhow::Result<()> {
-    if eye.length() <= config.planet.radius as f64 * 0.5 {
-        return Err(usage(format!(
-            "--eye {eye} is inside the planet (radius {})",
-            config.planet.radius
-        )));
-    }
+    camera_distance(eye, config).map_err(|e| usage(format!("--eye {e}")))?;
     if (look_at - eye).length() < 1e-9 {
         return Err(usage("--look-at must differ from --eye"));
     }
     Ok(())
+}
+
+/// The farthest a camera may be from the planet's centre, in radii: the planet is then a few pixels wide, and
+/// further out the camera-relative f32 positions of its patches lose their metres.
+const MAX_CAMERA_RADII: f64 = 1e4;
+
+/// Why a camera at `eye` cannot see this planet, if it cannot: inside it (below half its radius) or too far.
+fn camera_distance(eye: glam::DVec3, config: &riverplanet::config::Config) -> Result<(), String> {
+    let radius = config.planet.radius as f64;
+    if !eye.is_finite() || eye.length() <= radius * 0.5 {
+        return Err(format!("{eye} is inside the planet (radius {radius})"));
+    }
+    if eye.length() > radius * MAX_CAMERA_RADII {
+        return Err(format!(
+            "{eye} is {:.3e} radii from the planet's centre, more than {MAX_CAMERA_RADII:e} (radius {radius})",
+            eye.length() / radius
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a recorded camera as `--eye` is refused.
+pub(crate) fn check_path_frame(
+    frame: &riverplanet::runtime::camera_path::PathFrame,
+    config: &riverplanet::config::Config,
+) -> Result<(), String> {
+    camera_distance(glam::DVec3::from_array(frame.position), config)
 }
 
 /// Frame `number` (1-based; the last without one) of the camera path in `file`.

@@ -19,6 +19,11 @@ pub struct CameraPath {
     pub frames: Vec<PathFrame>,
 }
 
+/// The most frames a camera path may have: an hour at 30 frames a second.
+pub const MAX_FRAMES: usize = 108_000;
+/// The largest camera-path file read: a generous 1 KB a frame.
+const MAX_FILE_BYTES: u64 = MAX_FRAMES as u64 * 1024;
+
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 pub struct PathFrame {
     /// Seconds since the path started.
@@ -61,11 +66,27 @@ impl CameraPath {
     /// Reads a path, refusing one without frames or with a frame that is not finite, has no direction, or looks
     /// along its up (the message names the file and the frame).
     pub fn load(path: &Path) -> Result<Self, String> {
+        let bytes = std::fs::metadata(path)
+            .map_err(|e| format!("{}: {e}", path.display()))?
+            .len();
+        if bytes > MAX_FILE_BYTES {
+            return Err(format!(
+                "{}: {bytes} bytes, more than a path of {MAX_FRAMES} frames takes (at most {MAX_FILE_BYTES})",
+                path.display()
+            ));
+        }
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let camera_path: Self = serde_json::from_str(&text)
             .map_err(|e| format!("{}: not a camera path: {e}", path.display()))?;
         if camera_path.frames.is_empty() {
             return Err(format!("{}: the path has no frames", path.display()));
+        }
+        if camera_path.frames.len() > MAX_FRAMES {
+            return Err(format!(
+                "{}: {} frames, at most {MAX_FRAMES} (an hour at 30 frames a second)",
+                path.display(),
+                camera_path.frames.len()
+            ));
         }
         for (k, f) in camera_path.frames.iter().enumerate() {
             let [p, d, u] = [f.position, f.forward, f.up].map(DVec3::from_array);
