@@ -26,34 +26,34 @@ pub const RECYCLED_BYTES: u64 = 64 << 20;
 /// What a buffer must be to serve a request: its usage, memory and capacity class (memory.rs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct BufferShape {
-    pub usage: vk::BufferUsageFlags,
-    pub location: MemoryLocation,
-    pub capacity: u64,
+    pub(super) usage: vk::BufferUsageFlags,
+    pub(super) location: MemoryLocation,
+    pub(super) capacity: u64,
 }
 
 /// What an image must be to serve a request.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct ImageShape {
-    pub extent: vk::Extent2D,
-    pub format: vk::Format,
-    pub layers: u32,
-    pub array: bool,
-    pub usage: vk::ImageUsageFlags,
+    pub(super) extent: vk::Extent2D,
+    pub(super) format: vk::Format,
+    pub(super) layers: u32,
+    pub(super) array: bool,
+    pub(super) usage: vk::ImageUsageFlags,
 }
 
 /// A buffer's handle and memory, without its name and requested size.
 pub(super) struct BufferMemory {
-    pub raw: vk::Buffer,
-    pub allocation: Allocation,
-    pub shape: BufferShape,
+    pub(super) raw: vk::Buffer,
+    pub(super) allocation: Allocation,
+    pub(super) shape: BufferShape,
 }
 
 /// An image's handles and memory.
 pub(super) struct ImageMemory {
-    pub raw: vk::Image,
-    pub view: vk::ImageView,
-    pub allocation: Allocation,
-    pub shape: ImageShape,
+    pub(super) raw: vk::Image,
+    pub(super) view: vk::ImageView,
+    pub(super) allocation: Allocation,
+    pub(super) shape: ImageShape,
 }
 
 /// A GPU object waiting to be destroyed (or, a buffer or image, to be reused).
