@@ -340,20 +340,42 @@ fn the_root_must_be_one_planet_element() {
 
 #[test]
 fn a_base_resolution_that_no_level_holds_is_refused_by_the_configuration() {
-    // What `generate` used to refuse only after `config` had accepted it.
-    for (section, element, value) in [
-        ("rendering-attributes", "max-level-of-detail", "0"),
-        ("rendering-attributes", "max-level-of-detail", "1"),
-        ("planet-attributes", "base-resolution", "9"),
-    ] {
-        let message = error_of(&with(section, element, value));
+    // What `generate` used to refuse only after `config` had accepted it. Issue 38, finding 12: a level too shallow
+    // for the base resolution names the level (base-resolution is often not in the file), with what it must be.
+    for value in ["0", "1"] {
+        let message = error_of(&with("rendering-attributes", "max-level-of-detail", value));
         assert!(
-            message.contains("<base-resolution>") && message.contains("(vertices - 1) x 2^b + 1"),
-            "{element} {value}: {message}"
+            message.contains("<max-level-of-detail>")
+                && message.contains("must be at least 2, the level of base-resolution 129"),
+            "{value}: {message}"
         );
     }
+    let message = error_of(&with("planet-attributes", "base-resolution", "9"));
+    assert!(
+        message.contains("<base-resolution>") && message.contains("(vertices - 1) x 2^b + 1"),
+        "{message}"
+    );
     let ok = with("rendering-attributes", "max-level-of-detail", "2");
     assert_eq!(Config::parse(&ok, "t.xml").unwrap().base_level(), Some(2));
+}
+
+/// Issue 38, finding 12: every level too deep gets the same message, the bound with these vertices (27 was out of
+/// [0, 26] while 26 was "at most 25").
+#[test]
+fn every_level_too_deep_is_refused_with_the_bound_of_the_vertices() {
+    for value in ["26", "27", "4000000000"] {
+        let message = error_of(&with("rendering-attributes", "max-level-of-detail", value));
+        assert!(
+            message.contains("<max-level-of-detail>")
+                && message.contains("at most 25 with vertices 33"),
+            "{value}: {message}"
+        );
+    }
+    Config::parse(
+        &with("rendering-attributes", "max-level-of-detail", "25"),
+        "t.xml",
+    )
+    .unwrap();
 }
 
 #[test]

@@ -35,8 +35,6 @@ pub enum ConfigError {
     },
 }
 
-/// The deepest `max-level-of-detail` accepted (33 vertices per patch edge allow 25: see MAX_LATTICE_CELLS).
-pub const MAX_LEVEL_OF_DETAIL: u32 = 26;
 /// Lattice cells per face edge at the deepest level, at most.
 pub const MAX_LATTICE_CELLS: u32 = 1 << 30;
 

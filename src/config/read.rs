@@ -9,7 +9,7 @@ use xml::reader::{EventReader, XmlEvent};
 
 use super::{
     Config, ConfigError, PlanetConfig, ReliefModel, RenderingConfig, RiverConfig, RiverModel,
-    MAX_LATTICE_CELLS, MAX_LEVEL_OF_DETAIL,
+    MAX_LATTICE_CELLS,
 };
 use crate::named::Named;
 
@@ -172,7 +172,8 @@ const RIVER: &[Param<RiverConfig>] = &[
 /// `<rendering-attributes>`.
 const RENDERING: &[Param<RenderingConfig>] = &[
     Param::Grid("vertices", 3, 129, |c| &mut c.vertices),
-    Param::Whole("max-level-of-detail", 0, MAX_LEVEL_OF_DETAIL, |c| {
+    // Bounded by `check` against `vertices` (25 with 33): one rule, one message, whatever the value.
+    Param::Whole("max-level-of-detail", 0, u32::MAX, |c| {
         &mut c.max_level_of_detail
     }),
     Param::Number("level-of-detail-switch-factor", Range::Positive, |c| {
@@ -636,11 +637,26 @@ impl Config {
             ));
         }
         if self.base_level().is_none() {
-            return Err(error(
-                "base-resolution",
-                self.planet.base_resolution.to_string(),
-                self.base_resolution_rule(),
-            ));
+            // A base resolution of the file's vertices that only a deeper level reaches: the level is at fault,
+            // not base-resolution (which is often not in the file at all).
+            let (n, cells) = (rendering.vertices - 1, planet.base_resolution - 1);
+            let needed =
+                (cells % n == 0 && (cells / n).is_power_of_two()).then(|| (cells / n).ilog2());
+            return Err(match needed {
+                Some(level) => error(
+                    "max-level-of-detail",
+                    rendering.max_level_of_detail.to_string(),
+                    format!(
+                        "must be at least {level}, the level of base-resolution {} with vertices {}",
+                        planet.base_resolution, rendering.vertices
+                    ),
+                ),
+                None => error(
+                    "base-resolution",
+                    self.planet.base_resolution.to_string(),
+                    self.base_resolution_rule(),
+                ),
+            });
         }
         Ok(())
     }
