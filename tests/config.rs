@@ -454,3 +454,35 @@ fn a_run_without_morphing_takes_the_thesis_rule_unless_another_is_asked_for() {
         LodRule::Distance
     );
 }
+
+/// Issue 38, finding 11: a flag is `true` or `false` as its message says (any case, and Appendix A's one stray `>`),
+/// and the thesis's alias next to the element it names is the element given twice.
+#[test]
+fn flags_are_true_or_false_and_an_alias_is_the_same_element() {
+    for bad in ["yes", "1", "0", "no", ">>true"] {
+        let message = error_of(&with("planet-attributes", "continents-from-file", bad));
+        assert!(
+            message.contains("<continents-from-file>") && message.contains("true or false"),
+            "{bad}: {message}"
+        );
+    }
+    for good in [">false", "FALSE", "false"] {
+        let c = Config::parse(
+            &with("planet-attributes", "continents-from-file", good),
+            "t",
+        )
+        .unwrap();
+        assert!(!c.planet.continents_from_file);
+    }
+    let both = with("rendering-attributes", "max-level-of-detail", "5").replacen(
+        "<rendering-attributes>",
+        "<rendering-attributes>\n    <mas-level-of-detail>6</mas-level-of-detail>",
+        1,
+    );
+    let message = error_of(&both);
+    assert!(
+        message.contains("<max-level-of-detail> appears twice")
+            && message.contains("<mas-level-of-detail>"),
+        "{message}"
+    );
+}

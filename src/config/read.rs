@@ -217,12 +217,24 @@ pub fn elements() -> Vec<(&'static str, &'static str)> {
     .concat()
 }
 
-/// Strips what the thesis's C++ file format tolerated: surrounding space, a C float suffix, a stray leading `>`.
+/// Strips what the thesis's C++ file format tolerated: surrounding space, a C float suffix, one stray leading `>`
+/// (Appendix A prints `<continents-from-file>>false`).
 fn clean(text: &str) -> &str {
-    let t = text.trim().trim_start_matches('>').trim();
+    let t = text.trim();
+    let t = t.strip_prefix('>').unwrap_or(t).trim();
     t.strip_suffix(['f', 'F'])
         .filter(|s| s.parse::<f64>().is_ok())
         .unwrap_or(t)
+}
+
+/// An element's name as the tables know it: Table 6.1 prints "mas-level-of-detail", Appendix A
+/// "max-level-of-detail"; both are accepted, as one element.
+fn canonical(element: &str) -> &str {
+    if element == "mas-level-of-detail" {
+        "max-level-of-detail"
+    } else {
+        element
+    }
 }
 
 /// The text of the elements of one section, in file order.
@@ -276,8 +288,19 @@ fn sections(text: &str, path: &str) -> Result<Vec<(String, Section)>, ConfigErro
                     }
                     2 => {
                         let section = &mut out.last_mut().expect("a section is open").1;
-                        if section.iter().any(|(e, _)| *e == name) {
-                            return Err(error(format!("<{name}> appears twice in <{}>", open[1])));
+                        if let Some((first, _)) = section
+                            .iter()
+                            .find(|(e, _)| canonical(e) == canonical(&name))
+                        {
+                            return Err(error(if *first == name {
+                                format!("<{name}> appears twice in <{}>", open[1])
+                            } else {
+                                format!(
+                                    "<{}> appears twice in <{}>, as <{first}> and <{name}>",
+                                    canonical(&name),
+                                    open[1]
+                                )
+                            }));
                         }
                         section.push((name.clone(), String::new()));
                     }
@@ -332,12 +355,7 @@ fn read_section<S>(
         expected,
     };
     for (element, text) in elements {
-        // Table 6.1 prints "mas-level-of-detail"; Appendix A "max-level-of-detail". Both are accepted.
-        let wanted = if element == "mas-level-of-detail" {
-            "max-level-of-detail"
-        } else {
-            element.as_str()
-        };
+        let wanted = canonical(element);
         let Some(param) = table.iter().find(|p| p.name() == wanted) else {
             let names: Vec<&str> = table.iter().map(Param::name).collect();
             return Err(ConfigError::UnknownElement {
@@ -386,8 +404,8 @@ fn read_section<S>(
                 }
             },
             Param::Flag(_, field) => match value.to_ascii_lowercase().as_str() {
-                "true" | "1" | "yes" => *field(target) = true,
-                "false" | "0" | "no" => *field(target) = false,
+                "true" => *field(target) = true,
+                "false" => *field(target) = false,
                 _ => return Err(error(wanted, text, "must be true or false".into())),
             },
             Param::Choice(_, set) => {
