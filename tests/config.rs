@@ -486,3 +486,35 @@ fn flags_are_true_or_false_and_an_alias_is_the_same_element() {
         "{message}"
     );
 }
+
+/// Issue 38, findings 9 and 15: a configuration with entity declarations is refused before it is expanded; UTF-16
+/// with a byte-order mark (legal XML) reads as the same configuration, and a file of neither encoding is refused once,
+/// with the reason (it was printed twice).
+#[test]
+fn entities_are_refused_and_utf16_is_read() {
+    let bomb = format!(
+        "<!DOCTYPE planet [<!ENTITY a \"{}\"><!ENTITY b \"{}\">]><planet><planet-attributes><radius>&b;</radius></planet-attributes></planet>",
+        "x".repeat(1000),
+        "&a;".repeat(1000)
+    );
+    let message = error_of(&bomb);
+    assert!(message.contains("entity declarations"), "{message}");
+    let dir = std::env::temp_dir().join(format!("riverplanet-config-utf16-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let utf16 = dir.join("utf16.xml");
+    let bytes: Vec<u8> = [0xFF, 0xFE]
+        .into_iter()
+        .chain(APPENDIX_A.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    std::fs::write(&utf16, bytes).unwrap();
+    let read = Config::load(&utf16).unwrap();
+    let direct = Config::parse(APPENDIX_A, &utf16.display().to_string()).unwrap();
+    assert_eq!(format!("{read:?}"), format!("{direct:?}"));
+    let latin1 = dir.join("latin1.xml");
+    std::fs::write(&latin1, b"<planet>\xe9</planet>").unwrap();
+    let message = Config::load(&latin1).unwrap_err().to_string();
+    assert!(
+        message.contains("not UTF-8") && message.matches("invalid utf-8").count() == 1,
+        "{message}"
+    );
+}

@@ -16,12 +16,9 @@ pub use read::elements;
 /// A configuration problem: which file, which element, what was wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("cannot read configuration file {path}: {source}")]
-    Read {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    // The reason is in the message, not a source: printed with its chain, it appeared twice.
+    #[error("cannot read configuration file {path}: {reason}")]
+    Read { path: String, reason: String },
     #[error("{path}: malformed configuration XML: {message}")]
     Xml { path: String, message: String },
     #[error("{path}: unknown element {detail}")]
@@ -300,13 +297,52 @@ impl Default for Config {
     }
 }
 
+/// The largest configuration file read (the shipped ones are 2-3 KB).
+const MAX_FILE_BYTES: u64 = 1 << 20;
+
+/// The text of a configuration file: UTF-8 (with or without a byte-order mark) or UTF-16 with one, as XML allows.
+fn decode(bytes: &[u8]) -> Result<String, String> {
+    let utf16 = |big_endian: bool| {
+        if bytes.len() % 2 != 0 {
+            return Err("UTF-16 (by its byte-order mark) of an odd number of bytes".to_string());
+        }
+        let units: Vec<u16> = bytes[2..]
+            .chunks_exact(2)
+            .map(|c| match big_endian {
+                true => u16::from_be_bytes([c[0], c[1]]),
+                false => u16::from_le_bytes([c[0], c[1]]),
+            })
+            .collect();
+        String::from_utf16(&units).map_err(|e| format!("not valid UTF-16: {e}"))
+    };
+    match bytes {
+        [0xFF, 0xFE, ..] => utf16(false),
+        [0xFE, 0xFF, ..] => utf16(true),
+        [0xEF, 0xBB, 0xBF, rest @ ..] => {
+            String::from_utf8(rest.to_vec()).map_err(|e| e.to_string())
+        }
+        _ => String::from_utf8(bytes.to_vec())
+            .map_err(|e| format!("not UTF-8 ({e}), nor UTF-16 with a byte-order mark")),
+    }
+}
+
 impl Config {
     /// Reads and validates a configuration file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        let refuse = |reason: String| ConfigError::Read {
             path: path.display().to_string(),
-            source,
-        })?;
+            reason,
+        };
+        let bytes = std::fs::metadata(path)
+            .map_err(|e| refuse(e.to_string()))?
+            .len();
+        if bytes > MAX_FILE_BYTES {
+            return Err(refuse(format!(
+                "{bytes} bytes, more than the {MAX_FILE_BYTES} a configuration may have"
+            )));
+        }
+        let bytes = std::fs::read(path).map_err(|e| refuse(e.to_string()))?;
+        let text = decode(&bytes).map_err(refuse)?;
         Self::parse(&text, &path.display().to_string())
     }
 

@@ -247,6 +247,13 @@ fn sections(text: &str, path: &str) -> Result<Vec<(String, Section)>, ConfigErro
         path: path.to_string(),
         message,
     };
+    // A configuration has no use for entities, and nested ones expand quadratically or worse (a 300 KB file made a
+    // 300 MB string before anything was refused).
+    if text.contains("<!ENTITY") {
+        return Err(error(
+            "entity declarations (<!ENTITY ...>) are not accepted in a configuration".to_string(),
+        ));
+    }
     let mut out: Vec<(String, Section)> = Vec::new();
     // The open elements, outermost first.
     let mut open: Vec<String> = Vec::new();
