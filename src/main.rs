@@ -87,6 +87,13 @@ fn main() -> ExitCode {
         Command::Bench { what } => finish(run_bench(&options, what)),
         Command::Config { file } => finish((|| {
             let config = Config::load(&file)?;
+            // What generate would refuse, config refuses too: the continents image is read as generate reads it.
+            if config.planet.continents_from_file {
+                riverplanet::planet::continents::ContinentImage::load(std::path::Path::new(
+                    &config.planet.continents_image,
+                ))
+                .map_err(|e| usage(format!("<continents-image> of {}: {e}", file.display())))?;
+            }
             log::info!("resolved configuration: {config:?}");
             println!("{}", serde_json::to_string_pretty(&config)?);
             Ok(())

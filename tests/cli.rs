@@ -1054,3 +1054,44 @@ fn cameras_out_of_the_planets_reach_are_refused_before_any_work() {
         .unwrap();
     assert_refused(&run, 2, &["--path", "frames, at most"]);
 }
+
+/// Issue 38, finding 10: what `generate` refuses, `config` refuses: a continents image that is missing, corrupt,
+/// too small or all sea, named with the file.
+#[test]
+fn config_refuses_the_continents_images_generate_would() {
+    let dir = temp_dir("continents-image");
+    let planet = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml"),
+    )
+    .unwrap();
+    let corrupt = dir.join("corrupt.png");
+    std::fs::write(&corrupt, b"not a png").unwrap();
+    let tiny = dir.join("tiny.png");
+    image::GrayImage::from_pixel(1, 1, image::Luma([255]))
+        .save(&tiny)
+        .unwrap();
+    let sea = dir.join("sea.png");
+    image::GrayImage::from_pixel(64, 32, image::Luma([0]))
+        .save(&sea)
+        .unwrap();
+    for (image, reason) in [
+        (dir.join("missing.png"), "No such file"),
+        (corrupt, "cannot read"),
+        (tiny, "1x1"),
+        (sea, "all sea"),
+    ] {
+        let file = dir.join("with-image.xml");
+        let text = planet.replacen(
+            "<continents-from-file>>false</continents-from-file>",
+            &format!(
+                "<continents-from-file>true</continents-from-file><continents-image>{}</continents-image>",
+                image.display()
+            ),
+            1,
+        );
+        assert_ne!(text, planet);
+        std::fs::write(&file, text).unwrap();
+        let run = riverplanet().arg("config").arg(&file).output().unwrap();
+        assert_refused(&run, 2, &["<continents-image>", reason]);
+    }
+}
