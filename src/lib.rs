@@ -16,6 +16,7 @@ pub mod drainage;
 pub mod export;
 pub mod geomorphology;
 pub mod gpu;
+pub mod interrupt;
 pub mod kernel;
 pub mod named;
 pub mod planet;

@@ -26,6 +26,8 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // Before any thread starts: SIGINT and SIGTERM stop every command cleanly (src/interrupt.rs).
+    riverplanet::interrupt::start();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let mut options = ContextOptions::from_env();

@@ -1095,3 +1095,57 @@ fn config_refuses_the_continents_images_generate_would() {
         assert_refused(&run, 2, &["<continents-image>", reason]);
     }
 }
+
+/// Issue 38, finding 2: SIGINT and SIGTERM stop a command with a message and the shell's exit code (130, 143),
+/// leaving no temporary file; a temporary file that a killed run left (SIGKILL) is removed by the next run that
+/// writes there.
+#[cfg(unix)]
+#[test]
+fn interrupted_commands_stop_cleanly_and_leftovers_of_killed_ones_go() {
+    let dir = temp_dir("interrupt");
+    for (signal, code, name) in [
+        (libc::SIGINT, 130, "SIGINT"),
+        (libc::SIGTERM, 143, "SIGTERM"),
+    ] {
+        let out = dir.join(name);
+        let child = riverplanet()
+            .args(["export", "faces", "--seed", "1", "--level", "5", "--out"])
+            .arg(&out)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        // SAFETY: signalling our own child.
+        unsafe { libc::kill(child.id() as i32, signal) };
+        let run = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(code), "{stderr}");
+        assert!(stderr.contains(&format!("stopped by {name}")), "{stderr}");
+        let left: Vec<_> = std::fs::read_dir(&out)
+            .map(|entries| entries.flatten().map(|e| e.file_name()).collect())
+            .unwrap_or_default();
+        assert!(
+            left.iter()
+                .all(|f| !f.to_string_lossy().contains(".partial-")),
+            "{left:?}"
+        );
+    }
+    // A leftover of a process that is gone, as SIGKILL leaves one.
+    let out = dir.join("killed");
+    std::fs::create_dir_all(&out).unwrap();
+    let mut gone = std::process::Command::new("true").spawn().unwrap();
+    gone.wait().unwrap();
+    let leftover = out.join(format!(".face0.tif.partial-{}", gone.id()));
+    std::fs::write(&leftover, b"half a face").unwrap();
+    succeeded(
+        riverplanet()
+            .args(["export", "faces", "--seed", "1", "--level", "0", "--out"])
+            .arg(&out),
+    );
+    assert!(
+        !leftover.exists(),
+        "the killed run's temporary file is still there"
+    );
+    assert!(out.join("face0.tif").exists());
+}

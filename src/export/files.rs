@@ -1,6 +1,7 @@
 //! Every output file goes through here: written to a temporary sibling and renamed into place, so a failed or
-//! interrupted write leaves neither a partial file nor a destroyed old one; and output paths are checked before
-//! any work starts, so a run is never thrown away for a typo.
+//! interrupted write leaves neither a partial file nor a destroyed old one (a stopped program removes its temporary
+//! files, src/interrupt.rs; the next write removes those a killed one left); and output paths are checked before any
+//! work starts, so a run is never thrown away for a typo.
 
 use std::{
     fs,
@@ -32,13 +33,71 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), ExportError> {
+    remove_leftovers(path);
     let temporary = partial(path);
+    in_progress().push(temporary.clone());
     let result =
         write(&temporary).and_then(|()| fs::rename(&temporary, path).map_err(|e| e.to_string()));
     if result.is_err() {
         let _ = fs::remove_file(&temporary);
     }
+    in_progress().retain(|p| *p != temporary);
     result.map_err(|message| error(path, message))
+}
+
+/// The temporary files being written now, for [`remove_partial_files`].
+fn in_progress() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    static FILES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+    FILES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes the temporary files being written (src/interrupt.rs, when the program is stopped); how many.
+pub fn remove_partial_files() -> usize {
+    in_progress()
+        .drain(..)
+        .filter(|p| fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// Removes the temporary siblings of `path` that killed runs left (SIGKILL, a power cut): those whose process is
+/// gone.
+fn remove_leftovers(path: &Path) {
+    let (Some(folder), Some(name)) = (path.parent(), path.file_name()) else {
+        return;
+    };
+    let folder = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
+    let prefix = format!(".{}.partial-", name.to_string_lossy());
+    let Ok(entries) = fs::read_dir(folder) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let pid = file
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<i32>().ok());
+        if pid.is_some_and(|pid| pid != std::process::id() as i32 && !alive(pid)) {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether process `pid` exists.
+#[cfg(unix)]
+fn alive(pid: i32) -> bool {
+    // SAFETY: signal 0 only checks that the process exists.
+    unsafe {
+        libc::kill(pid, 0) == 0
+            || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+}
+
+#[cfg(not(unix))]
+fn alive(_: i32) -> bool {
+    true
 }
 
 /// Writes `bytes` to `path` atomically.
@@ -112,4 +171,35 @@ pub fn check_output(argument: &str, path: &Path, png_only: bool) -> Result<(), S
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What the stopping thread does mid-write: the temporary file goes, the old file stays, nothing is left listed.
+    #[test]
+    fn a_stop_mid_write_removes_the_temporary_file_and_keeps_the_old_one() {
+        let dir = std::env::temp_dir().join(format!("riverplanet-files-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("face0.tif");
+        fs::write(&path, b"old").unwrap();
+        let mut removed = 0;
+        let result = write_atomically(&path, |temporary| {
+            fs::write(temporary, b"half").unwrap();
+            removed = remove_partial_files();
+            assert!(!temporary.exists());
+            Err("stopped".into())
+        });
+        assert!(result.is_err());
+        // At least ours (another test may be writing at the same time).
+        assert!(removed >= 1);
+        assert_eq!(fs::read(&path).unwrap(), b"old");
+        let left: Vec<_> = fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        assert_eq!(left.len(), 1, "{left:?}");
+    }
 }

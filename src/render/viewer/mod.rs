@@ -7,12 +7,11 @@
 //! planet), wheel zoom, C fly/orbit, Shift faster; M water mode,
 //! T atmosphere, F wireframe, L level-of-detail colours, R painted rivers in red, Z freeze level of detail, O morphing, G
 //! level-of-detail rule (screen-space error or the thesis's Eq. 6.1), K simple/tiled kernel, H back to the start
-//! view, P screenshot (screenshot.rs), B bookmark the view, 1-9 back to a bookmark (viewer_paths.rs), Escape quit (SIGTERM and SIGINT too, stop.rs). The camera stays
+//! view, P screenshot (screenshot.rs), B bookmark the view, 1-9 back to a bookmark (viewer_paths.rs), Escape quit (SIGTERM and SIGINT too, src/interrupt.rs). The camera stays
 //! above the drawn surface (ground.rs).
 
 mod input;
 mod screenshot;
-mod stop;
 
 use std::{collections::HashSet, path::PathBuf, time::Instant};
 
@@ -145,7 +144,7 @@ pub fn run(
         error: None,
     };
     app.keep_above_ground();
-    stop::install();
+    crate::interrupt::defer();
     event_loop.set_control_flow(ControlFlow::Poll);
     let run = event_loop
         .run_app(&mut app)
@@ -510,7 +509,7 @@ impl ApplicationHandler for App<'_> {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if let Some(signal) = stop::requested() {
+        if let Some(signal) = crate::interrupt::requested() {
             println!("{signal}: stopping");
             if let Some(path) = self.options.screenshot.clone() {
                 if let Err(e) = self.screenshot(&path) {
