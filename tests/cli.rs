@@ -1149,3 +1149,91 @@ fn interrupted_commands_stop_cleanly_and_leftovers_of_killed_ones_go() {
     );
     assert!(out.join("face0.tif").exists());
 }
+
+/// Issue 38, findings 1 and 3: a set of outputs replaces the old one as a whole or not at all. A run stopped before
+/// it is done leaves the old faces and layout.json byte for byte, and the user's own file in the folder; a finished
+/// run replaces the set and keeps that file; a half-written set a killed run left beside the folder is removed.
+#[cfg(unix)]
+#[test]
+fn an_output_set_is_replaced_whole_or_not_at_all() {
+    let dir = temp_dir("output-set");
+    let out = dir.join("faces");
+    let export = |seed: &str, level: &str| {
+        let mut command = riverplanet();
+        command
+            .args(["export", "faces", "--seed", seed, "--level", level, "--out"])
+            .arg(&out);
+        command
+    };
+    succeeded(&mut export("1", "0"));
+    std::fs::write(out.join("notes.txt"), b"mine").unwrap();
+    let snapshot = || -> Vec<(std::ffi::OsString, Vec<u8>)> {
+        let mut files: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .flatten()
+            .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
+            .collect();
+        files.sort();
+        files
+    };
+    let before = snapshot();
+    let mut child = export("2", "5")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Stopped while writing the third face (two written before it): its temporary file in the folder, or in a
+    // temporary folder beside it.
+    let writing = || {
+        let mut folders = vec![out.clone()];
+        folders.extend(
+            std::fs::read_dir(&dir)
+                .into_iter()
+                .flatten()
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| p.is_dir()),
+        );
+        folders.iter().any(|folder| {
+            std::fs::read_dir(folder).is_ok_and(|entries| {
+                entries.flatten().any(|e| {
+                    e.file_name()
+                        .to_string_lossy()
+                        .starts_with(".face2.tif.partial-")
+                })
+            })
+        })
+    };
+    let start = std::time::Instant::now();
+    while !writing() {
+        assert!(
+            child.try_wait().unwrap().is_none() && start.elapsed().as_secs() < 120,
+            "the export was never seen writing"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    assert!(snapshot() == before, "the stopped run changed the old set");
+    // A killed run's half-written set beside the folder.
+    let mut gone = std::process::Command::new("true").spawn().unwrap();
+    gone.wait().unwrap();
+    let leftover = dir.join(format!(".faces.partial-{}", gone.id()));
+    std::fs::create_dir_all(&leftover).unwrap();
+    std::fs::write(leftover.join("face0.tif"), b"half").unwrap();
+    succeeded(&mut export("2", "0"));
+    let layout: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("layout.json")).unwrap()).unwrap();
+    assert_eq!(layout["seed"], 2, "{layout}");
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
+    assert!(!leftover.exists(), "the killed run's set is still there");
+    let hidden: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .filter(|n| n.to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+}

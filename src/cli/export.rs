@@ -34,10 +34,11 @@ pub fn export(what: ExportCommand) -> anyhow::Result<()> {
             let seed = planet_seed(planet.seed, &config);
             let world = World::build(&config, seed)?;
             let lattice = carved_terrain(&world.planet, &world.network, &config, level);
-            std::fs::create_dir_all(&out)
-                .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
             let metadata = planet_metadata(&world.planet, seed, level, true);
-            let layout = write_faces(&lattice, format, &out, &metadata)?;
+            // The faces and layout.json replace the folder's old set as a whole, or not at all.
+            let set = export::files::OutputSet::begin(&out)?;
+            let layout = write_faces(&lattice, format, set.path(), &metadata)?;
+            set.commit()?;
             println!(
                 "{}: 6 faces of {side} x {side} at level {level}, heights {} to {}",
                 out.display(),

@@ -56,12 +56,13 @@ pub fn generate(
     if let Some(bar) = &bar {
         bar.set_message("writing");
     }
-    std::fs::create_dir_all(out)
-        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
+    // Everything below replaces the folder's old set as a whole, or not at all.
+    let set = riverplanet::export::files::OutputSet::begin(out)?;
+    let dir = set.path();
     let faces = planet.face_lattice(level);
     let faces_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = std::time::Instant::now();
-    let faces_dir = out.join("faces");
+    let faces_dir = dir.join("faces");
     std::fs::create_dir_all(&faces_dir)
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", faces_dir.display()))?;
     let metadata = riverplanet::export::heightmaps::planet_metadata(&planet, seed, level, false);
@@ -72,7 +73,7 @@ pub fn generate(
         &metadata,
     )?;
     if preview {
-        let path = out.join("preview.png");
+        let path = dir.join("preview.png");
         let mut image = riverplanet::export::preview(&planet, 256);
         match &planet.drainage {
             Some(drainage) => {
@@ -83,11 +84,11 @@ pub fn generate(
         riverplanet::export::files::save_image(&image, &path)?;
     }
     if equirect {
-        let path = out.join("continents.png");
+        let path = dir.join("continents.png");
         let land = riverplanet::export::equirectangular_land(&planet, 1024);
         riverplanet::export::files::save_image(&land, &path)?;
     }
-    let path = out.join("rivers.geojson");
+    let path = dir.join("rivers.geojson");
     let geojson = match &planet.drainage {
         Some(drainage) => riverplanet::export::drainage::drainage_geojson(drainage, &config),
         None => riverplanet::export::rivers_geojson(&network, geojson_depth, planet.radius),
@@ -133,11 +134,12 @@ pub fn generate(
         }
         value["river_systems"] = serde_json::json!(rivers);
     }
-    let path = out.join("stats.json");
+    let path = dir.join("stats.json");
     riverplanet::export::files::write_bytes(
         &path,
         serde_json::to_string_pretty(&value)?.as_bytes(),
     )?;
+    set.commit()?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

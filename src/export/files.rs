@@ -55,8 +55,107 @@ fn in_progress() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 pub fn remove_partial_files() -> usize {
     in_progress()
         .drain(..)
-        .filter(|p| fs::remove_file(p).is_ok())
+        .filter(|p| match p.is_dir() {
+            true => fs::remove_dir_all(p).is_ok(),
+            false => fs::remove_file(p).is_ok(),
+        })
         .count()
+}
+
+/// Files written as one set into a folder (the six faces and layout.json; generate's faces, stats and rivers):
+/// written into a hidden sibling folder, which [`OutputSet::commit`] swaps with the folder in one atomic rename
+/// (Linux's RENAME_EXCHANGE), so a run that fails, is stopped or killed, or runs out of disk leaves the old set
+/// whole. Files in the folder that the new set does not write are kept. Dropped uncommitted, the new set is removed.
+pub struct OutputSet {
+    folder: PathBuf,
+    staging: PathBuf,
+    committed: bool,
+}
+
+impl OutputSet {
+    /// Starts a set for `folder` (whose parent exists: `check_folder`), removing what killed runs left beside it.
+    pub fn begin(folder: &Path) -> Result<Self, ExportError> {
+        remove_leftovers(folder);
+        let staging = partial(folder);
+        let _ = fs::remove_dir_all(&staging);
+        fs::create_dir(&staging).map_err(|e| error(&staging, e))?;
+        in_progress().push(staging.clone());
+        Ok(Self {
+            folder: folder.to_path_buf(),
+            staging,
+            committed: false,
+        })
+    }
+
+    /// Where the set's files are written until it is committed.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Puts the set in place of the folder at once, keeps the folder's files that the set does not replace, and
+    /// removes the old set.
+    pub fn commit(mut self) -> Result<(), ExportError> {
+        let fail = |e: std::io::Error| error(&self.folder, e);
+        if !self.folder.exists() {
+            fs::rename(&self.staging, &self.folder).map_err(fail)?;
+        } else {
+            exchange(&self.staging, &self.folder).map_err(fail)?;
+            // `staging` now holds the old folder: keep what the new set does not write.
+            for entry in fs::read_dir(&self.staging).map_err(fail)?.flatten() {
+                let target = self.folder.join(entry.file_name());
+                if !target.exists() && !left_by_a_dead_run(&entry.file_name().to_string_lossy()) {
+                    fs::rename(entry.path(), target).map_err(fail)?;
+                }
+            }
+            let _ = fs::remove_dir_all(&self.staging);
+        }
+        in_progress().retain(|p| *p != self.staging);
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = fs::remove_dir_all(&self.staging);
+            in_progress().retain(|p| *p != self.staging);
+        }
+    }
+}
+
+/// Swaps two paths in one step where the system can (Linux), else in two renames through a third name.
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let (ca, cb) = (
+            std::ffi::CString::new(a.as_os_str().as_bytes())?,
+            std::ffi::CString::new(b.as_os_str().as_bytes())?,
+        );
+        // SAFETY: two valid C strings; RENAME_EXCHANGE swaps the two existing paths atomically.
+        let done = unsafe {
+            libc::renameat2(
+                libc::AT_FDCWD,
+                ca.as_ptr(),
+                libc::AT_FDCWD,
+                cb.as_ptr(),
+                libc::RENAME_EXCHANGE,
+            )
+        };
+        if done == 0 {
+            return Ok(());
+        }
+    }
+    let aside = b.with_file_name(format!(
+        ".{}.old-{}",
+        b.file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        std::process::id()
+    ));
+    fs::rename(b, &aside)?;
+    fs::rename(a, b)?;
+    fs::rename(&aside, a)
 }
 
 /// Removes the temporary siblings of `path` that killed runs left (SIGKILL, a power cut): those whose process is
@@ -76,13 +175,23 @@ fn remove_leftovers(path: &Path) {
     };
     for entry in entries.flatten() {
         let file = entry.file_name().to_string_lossy().into_owned();
-        let pid = file
-            .strip_prefix(&prefix)
-            .and_then(|p| p.parse::<i32>().ok());
-        if pid.is_some_and(|pid| pid != std::process::id() as i32 && !alive(pid)) {
-            let _ = fs::remove_file(entry.path());
+        if file.starts_with(&prefix) && left_by_a_dead_run(&file) {
+            let path = entry.path();
+            let _ = match path.is_dir() {
+                true => fs::remove_dir_all(path),
+                false => fs::remove_file(path),
+            };
         }
     }
+}
+
+/// Whether `file` is a temporary file or set (`.NAME.partial-PID`) whose process is gone.
+fn left_by_a_dead_run(file: &str) -> bool {
+    let pid = file
+        .strip_prefix('.')
+        .and_then(|f| f.rsplit_once(".partial-"))
+        .and_then(|(_, pid)| pid.parse::<i32>().ok());
+    pid.is_some_and(|pid| pid != std::process::id() as i32 && !alive(pid))
 }
 
 /// Whether process `pid` exists.
