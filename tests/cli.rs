@@ -1237,3 +1237,63 @@ fn an_output_set_is_replaced_whole_or_not_at_all() {
         .collect();
     assert!(hidden.is_empty(), "{hidden:?}");
 }
+
+/// A tmpfs of `bytes` at `path`, unmounted when dropped; `None` where this machine does not let the test mount one.
+struct SmallDisk(std::path::PathBuf);
+
+impl SmallDisk {
+    fn mount(path: &std::path::Path, bytes: u64) -> Option<Self> {
+        std::fs::create_dir_all(path).ok()?;
+        let mounted = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={bytes}"), "tmpfs"])
+            .arg(path)
+            .output()
+            .is_ok_and(|o| o.status.success());
+        mounted.then(|| Self(path.to_path_buf()))
+    }
+}
+
+impl Drop for SmallDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+/// Issue 38, finding 3: a full disk leaves the old set as it was, no partial file and no half-written set (on a
+/// 2 MB tmpfs: the level-0 faces fit, level 4's 6 MB do not). Skipped, saying so, where mounting is not allowed.
+#[test]
+fn a_full_disk_leaves_the_old_set_whole() {
+    let dir = temp_dir("full-disk");
+    let Some(disk) = SmallDisk::mount(&dir.join("disk"), 2 << 20) else {
+        eprintln!("skipping: this machine does not let the test mount a tmpfs");
+        return;
+    };
+    let out = disk.0.join("faces");
+    let export = |level: &str| {
+        riverplanet()
+            .args(["export", "faces", "--seed", "1", "--level", level, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    assert!(export("0").status.success());
+    let snapshot = || -> Vec<(std::ffi::OsString, Vec<u8>)> {
+        let mut files: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .flatten()
+            .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
+            .collect();
+        files.sort();
+        files
+    };
+    let before = snapshot();
+    let run = export("4");
+    assert_refused(&run, 1, &["No space left on device"]);
+    assert!(snapshot() == before, "the old set changed");
+    let entries: Vec<_> = std::fs::read_dir(&disk.0)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(entries, vec![std::ffi::OsString::from("faces")]);
+}
