@@ -1150,6 +1150,17 @@ fn interrupted_commands_stop_cleanly_and_leftovers_of_killed_ones_go() {
     assert!(out.join("face0.tif").exists());
 }
 
+/// Every file of `folder` with its bytes, by name.
+fn files_of(folder: &std::path::Path) -> Vec<(std::ffi::OsString, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(folder)
+        .unwrap()
+        .flatten()
+        .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
+        .collect();
+    files.sort();
+    files
+}
+
 /// Issue 38, findings 1 and 3: a set of outputs replaces the old one as a whole or not at all. A run stopped before
 /// it is done leaves the old faces and layout.json byte for byte, and the user's own file in the folder; a finished
 /// run replaces the set and keeps that file; a half-written set a killed run left beside the folder is removed.
@@ -1167,16 +1178,7 @@ fn an_output_set_is_replaced_whole_or_not_at_all() {
     };
     succeeded(&mut export("1", "0"));
     std::fs::write(out.join("notes.txt"), b"mine").unwrap();
-    let snapshot = || -> Vec<(std::ffi::OsString, Vec<u8>)> {
-        let mut files: Vec<_> = std::fs::read_dir(&out)
-            .unwrap()
-            .flatten()
-            .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
-            .collect();
-        files.sort();
-        files
-    };
-    let before = snapshot();
+    let before = files_of(&out);
     let mut child = export("2", "5")
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
@@ -1216,7 +1218,10 @@ fn an_output_set_is_replaced_whole_or_not_at_all() {
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
-    assert!(snapshot() == before, "the stopped run changed the old set");
+    assert!(
+        files_of(&out) == before,
+        "the stopped run changed the old set"
+    );
     // A killed run's half-written set beside the folder.
     let mut gone = std::process::Command::new("true").spawn().unwrap();
     gone.wait().unwrap();
@@ -1277,19 +1282,10 @@ fn a_full_disk_leaves_the_old_set_whole() {
             .unwrap()
     };
     assert!(export("0").status.success());
-    let snapshot = || -> Vec<(std::ffi::OsString, Vec<u8>)> {
-        let mut files: Vec<_> = std::fs::read_dir(&out)
-            .unwrap()
-            .flatten()
-            .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
-            .collect();
-        files.sort();
-        files
-    };
-    let before = snapshot();
+    let before = files_of(&out);
     let run = export("4");
     assert_refused(&run, 1, &["No space left on device"]);
-    assert!(snapshot() == before, "the old set changed");
+    assert!(files_of(&out) == before, "the old set changed");
     let entries: Vec<_> = std::fs::read_dir(&disk.0)
         .unwrap()
         .flatten()
