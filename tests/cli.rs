@@ -1150,15 +1150,56 @@ fn interrupted_commands_stop_cleanly_and_leftovers_of_killed_ones_go() {
     assert!(out.join("face0.tif").exists());
 }
 
-/// Every file of `folder` with its bytes, by name.
-fn files_of(folder: &std::path::Path) -> Vec<(std::ffi::OsString, Vec<u8>)> {
-    let mut files: Vec<_> = std::fs::read_dir(folder)
-        .unwrap()
-        .flatten()
-        .map(|e| (e.file_name(), std::fs::read(e.path()).unwrap()))
-        .collect();
+/// Every file under `folder` with its bytes, by path.
+fn files_of(folder: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(folder).unwrap().flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files.extend(files_of(&path));
+        } else {
+            files.push((path.clone(), std::fs::read(&path).unwrap()));
+        }
+    }
     files.sort();
     files
+}
+
+/// Whether a set is being written in `folder`: a hidden `.NAME.partial-PID` folder in it that already holds
+/// `written` (a file of the set finished, the set not yet swapped in).
+fn writing(folder: &std::path::Path, written: &str) -> bool {
+    std::fs::read_dir(folder).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            let file = e.file_name().to_string_lossy().into_owned();
+            file.starts_with('.') && file.contains(".partial-") && e.path().join(written).exists()
+        })
+    })
+}
+
+/// Runs `command`, sends it SIGINT as soon as a set holding `name` is being written in `folder` (`writing`), and
+/// returns its exit code.
+#[cfg(unix)]
+fn interrupted_while_writing(
+    command: &mut Command,
+    folder: &std::path::Path,
+    name: &str,
+) -> Option<i32> {
+    let mut child = command
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !writing(folder, name) {
+        assert!(
+            child.try_wait().unwrap().is_none() && start.elapsed().as_secs() < 120,
+            "{name} was never seen being written"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    child.wait().unwrap().code()
 }
 
 /// Issue 38, findings 1 and 3: a set of outputs replaces the old one as a whole or not at all. A run stopped before
@@ -1179,45 +1220,12 @@ fn an_output_set_is_replaced_whole_or_not_at_all() {
     succeeded(&mut export("1", "0"));
     std::fs::write(out.join("notes.txt"), b"mine").unwrap();
     let before = files_of(&out);
-    let mut child = export("2", "5")
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    // Stopped while writing the third face (two written before it): its temporary file in the folder, or in a
-    // temporary folder beside it.
-    let writing = || {
-        let mut folders = vec![out.clone()];
-        folders.extend(
-            std::fs::read_dir(&dir)
-                .into_iter()
-                .flatten()
-                .flatten()
-                .map(|e| e.path())
-                .filter(|p| p.is_dir()),
-        );
-        folders.iter().any(|folder| {
-            std::fs::read_dir(folder).is_ok_and(|entries| {
-                entries.flatten().any(|e| {
-                    e.file_name()
-                        .to_string_lossy()
-                        .starts_with(".face2.tif.partial-")
-                })
-            })
-        })
-    };
-    let start = std::time::Instant::now();
-    while !writing() {
-        assert!(
-            child.try_wait().unwrap().is_none() && start.elapsed().as_secs() < 120,
-            "the export was never seen writing"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(1));
-    }
-    // SAFETY: signalling our own child.
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(130));
+    // Stopped while the set is written, its second face done (with the faces written in place, as before, no set
+    // shows and the test fails).
+    assert_eq!(
+        interrupted_while_writing(&mut export("2", "5"), &dir, "face1.tif"),
+        Some(130)
+    );
     assert!(
         files_of(&out) == before,
         "the stopped run changed the old set"
@@ -1292,4 +1300,36 @@ fn a_full_disk_leaves_the_old_set_whole() {
         .map(|e| e.file_name())
         .collect();
     assert_eq!(entries, vec![std::ffi::OsString::from("faces")]);
+}
+
+/// As `an_output_set_is_replaced_whole_or_not_at_all`, for `generate`: stopped while writing its set, it leaves the old faces, stats.json and rivers.geojson byte for byte.
+#[cfg(unix)]
+#[test]
+fn a_stopped_generate_leaves_the_old_planet_whole() {
+    let dir = temp_dir("generate-set");
+    let out = dir.join("planet");
+    let generate = |seed: &str, level: &str| {
+        let mut command = riverplanet();
+        command
+            .args(["generate", "--seed", seed, "--level", level, "--out"])
+            .arg(&out);
+        command
+    };
+    succeeded(&mut generate("1", "0"));
+    let before = files_of(&out);
+    assert!(before.len() >= 9, "{} files", before.len());
+    assert_eq!(
+        interrupted_while_writing(&mut generate("2", "5"), &dir, "faces/face1.png"),
+        Some(130)
+    );
+    assert!(
+        files_of(&out) == before,
+        "the stopped run changed the old planet"
+    );
+    let hidden = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .count();
+    assert_eq!(hidden, 0, "a half-written set is left");
 }
