@@ -206,12 +206,8 @@ fn staging_upload_reaches_device_local_buffer() {
 /// the GPU is done it is kept for a request of its shape, or freed (`release_recycled`), without a call to free it.
 #[test]
 fn dropped_buffers_and_images_are_kept_or_freed_once_the_gpu_is_done() {
-    if common::gpu().is_none() {
-        return;
-    }
     // A context of its own: the shared one's allocations change with the other tests.
-    let ctx =
-        riverplanet::gpu::Context::new(&riverplanet::gpu::ContextOptions::from_env()).unwrap();
+    let Some(ctx) = common::own_gpu() else { return };
     let before = ctx.live_allocations();
     let buffer = ctx
         .create_buffer(&BufferDesc {

@@ -12,20 +12,16 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     let (config, _) = load_config(args.planet.config.as_deref())?;
     check_output("--out", &args.out, true)?;
     let recorded = match &args.path {
-        Some(file) => Some(path_frame(file, args.path_frame)?),
+        Some(file) => {
+            let frame = path_frame(file, args.path_frame)?;
+            check_path_frame(&frame, &config)
+                .map_err(|e| usage(format!("--path {}: {e}", file.display())))?;
+            Some(frame)
+        }
         None => None,
     };
-    match &recorded {
-        Some(frame) => check_path_frame(frame, &config).map_err(|e| {
-            usage(format!(
-                "--path {}: {e}",
-                args.path
-                    .as_ref()
-                    .map_or(String::new(), |p| p.display().to_string())
-            ))
-        })?,
-        None if args.preset.is_none() => check_camera(args.eye, args.look_at, &config)?,
-        None => {}
+    if args.preset.is_none() && recorded.is_none() {
+        check_camera(args.eye, args.look_at, &config)?;
     }
     if !(0.0..=MAX_TIME_S).contains(&args.time) {
         return Err(usage(format!(

@@ -11,6 +11,7 @@ use std::path::Path;
 use serde::Serialize;
 
 mod read;
+mod rules;
 pub use read::elements;
 
 /// A configuration problem: which file, which element, what was wrong.
