@@ -304,9 +304,17 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
         "drained_land_fraction",
         "uphill_steps",
         "crossings",
+        "stream_sinuosity_median",
+        "stream_sinuosity_median_base",
     ] {
         assert!(stats[key].is_number(), "stats.json lacks {key}: {stats}");
     }
+    // The rivers as drawn wind at least as much as their base courses: the meanders below the base lattice add.
+    let (drawn, base) = (
+        stats["stream_sinuosity_median"].as_f64().unwrap(),
+        stats["stream_sinuosity_median_base"].as_f64().unwrap(),
+    );
+    assert!(drawn >= base && base >= 1.0, "drawn {drawn}, base {base}");
     for stage in ["relief", "drainage", "rivers"] {
         assert!(
             stats["timings_ms"][stage].is_number(),

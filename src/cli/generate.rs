@@ -1,6 +1,7 @@
 //! `riverplanet generate`: the planet's face images, preview, rivers and statistics.
 
 use crate::{load_config, planet_seed, usage};
+use riverplanet::geomorphology::profiles;
 
 /// The finest level `generate` writes face images at (8193 pixels per edge with 33 vertices).
 const MAX_FACE_IMAGE_LEVEL: u32 = 8;
@@ -126,6 +127,18 @@ pub fn generate(
         })
         .collect();
     if let Some(drainage) = &planet.drainage {
+        // The sinuosity of the rivers as drawn at their finest (docs/geomorphology.md).
+        let t = std::time::Instant::now();
+        let sinuous = |k: usize| drainage.reaches[k].strahler >= profiles::SINUOUS_ORDER;
+        let lengths = riverplanet::river::drainage::drawn_reach_lengths(
+            (&network.systems, &network.params),
+            drainage,
+            sinuous,
+        );
+        let sinuosity = profiles::sinuosity_median(&drainage.reaches, |k| lengths[k]);
+        value["stream_sinuosity_median"] =
+            serde_json::json!(sinuosity.is_finite().then_some(sinuosity));
+        value["timings_ms"]["drawn sinuosity"] = serde_json::json!(t.elapsed().as_secs_f64() * 1e3);
         // The drainage model's measures, at the top level (docs/rivers.md).
         if let serde_json::Value::Object(measures) = serde_json::to_value(&drainage.measures)? {
             for (key, v) in measures {

@@ -15,7 +15,7 @@ use glam::DVec3;
 use super::ReachPath;
 
 /// Wavelength of meanders in channel widths.
-const WAVELENGTH_WIDTHS: f64 = 11.0;
+pub const WAVELENGTH_WIDTHS: f64 = 11.0;
 /// The swing of the course's direction on a flat valley floor (radians): a sine-generated curve with this swing
 /// has a sinuosity of 1 / J0(1.25) = 1.55 (squeezed into the belt, less).
 const FLAT_SWING: f64 = 1.25;
@@ -23,6 +23,8 @@ const FLAT_SWING: f64 = 1.25;
 /// fallen to half of the flat one. The median order-3 reach of the default planet has 0.22. At 0.5 seed 3's median
 /// stream sinuosity was 1.23, below the 1.3-1.6 of real lowland rivers; 0.7 gives 1.27-1.36 on seeds 1-6.
 const HALF_SWING_SLOPE: f64 = 0.7;
+/// Courses swinging less than this (radians) stay on their valley line.
+pub const MIN_SWING: f64 = 0.05;
 /// Meanders shorter than this many base cells are left to the finer levels of detail (the thesis's subdivision).
 const SHORTEST_WAVELENGTH_CELLS: f64 = 0.5;
 /// Longer wavelengths are shortened to this: the belt must stay within [`BELT_CELLS`].
@@ -62,43 +64,11 @@ pub fn meander(reach: &ReachPath, scale: &MeanderScale, width: &impl Fn(f64) -> 
     }
     let wavelength = wavelength.min(LONGEST_WAVELENGTH_CELLS * scale.cell);
     let drop = (reach.beds[0] - reach.beds[reach.beds.len() - 1]) as f64;
-    let slope = drop / (length * scale.radius) / scale.relief_slope;
-    let swing = FLAT_SWING / (1.0 + (slope / HALF_SWING_SLOPE).powi(2));
-    if swing < 0.05 {
+    let swing = swing_on(drop / (length * scale.radius) / scale.relief_slope);
+    if swing < MIN_SWING {
         return reach.clone();
     }
-    // A whole number of half wavelengths along the channel, so the course crosses the valley line at both ends.
-    let channel = length * sinuosity_of(swing);
-    let halves = (2.0 * channel / wavelength).round().max(1.0);
-    let wavelength = 2.0 * channel / halves;
-    // Integrate the sine-generated curve in the valley's frame: x along the valley, y across it.
-    let steps = (halves * 0.5 * POINTS_PER_WAVELENGTH).ceil() as usize * STEPS_PER_POINT;
-    let ds = channel / steps as f64;
-    let (mut x, mut y) = (0.0, 0.0);
-    let mut course = vec![(0.0, 0.0)];
-    for step in 0..steps {
-        let theta = swing * (std::f64::consts::TAU * (step as f64 + 0.5) * ds / wavelength).cos();
-        x += theta.cos() * ds;
-        y += theta.sin() * ds;
-        if (step + 1) % STEPS_PER_POINT == 0 {
-            course.push((x, y));
-        }
-    }
-    // Onto the valley's ends exactly (the integration leaves a little drift), and within the belt.
-    let (end_x, end_y) = *course.last().expect("not empty");
-    // Near its ends the course eases onto the valley line over half a wavelength, so a tributary meets its main
-    // stem along its valley instead of swinging across the other's course.
-    let ease = |x: f64| {
-        let t = (x.min(length - x) / (0.5 * wavelength)).clamp(0.0, 1.0);
-        t * t * (3.0 - 2.0 * t)
-    };
-    let course: Vec<(f64, f64)> = course
-        .iter()
-        .map(|&(x, y)| {
-            let x = x * length / end_x;
-            (x, (y - end_y * x / length) * ease(x))
-        })
-        .collect();
+    let course = sine_course(length, wavelength, swing, POINTS_PER_WAVELENGTH);
     let widest = course.iter().map(|c| c.1.abs()).fold(0.0, f64::max);
     let squeeze = (BELT_CELLS * scale.cell / widest.max(1e-12)).min(1.0);
     let points: Vec<DVec3> = course
@@ -196,6 +166,62 @@ pub fn crossing_reaches(reaches: &[ReachPath]) -> std::collections::BTreeSet<usi
     crossing
 }
 
+/// The swing of a course whose valley falls by `slope` (drop over run, as a share of the planet's relief over its
+/// radius): [`FLAT_SWING`] on a flat floor, half of it at [`HALF_SWING_SLOPE`] (Schumm 1963).
+pub fn swing_on(slope: f64) -> f64 {
+    FLAT_SWING / (1.0 + (slope / HALF_SWING_SLOPE).powi(2))
+}
+
+/// A sine-generated course along a valley line of `length` (any unit): its direction swings about the valley's by
+/// `swing cos(2 pi s / wavelength)` along the channel's length s, over the whole number of half wavelengths nearest
+/// to `wavelength` (at least one), so it crosses the valley line at both ends. Points (x along the valley, y across
+/// it), `points_per_wavelength` per wavelength, from (0, 0) to (`length`, 0); over half a wavelength from each end
+/// the course eases onto the valley line (y and its slope 0 at the ends), so it leaves and joins along the valley.
+pub fn sine_course(
+    length: f64,
+    wavelength: f64,
+    swing: f64,
+    points_per_wavelength: f64,
+) -> Vec<(f64, f64)> {
+    let channel = length * sinuosity_of(swing);
+    let halves = half_wavelengths(length, wavelength, swing).max(1.0);
+    let wavelength = 2.0 * channel / halves;
+    // Integrate the sine-generated curve in the valley's frame.
+    let steps = (halves * 0.5 * points_per_wavelength).ceil() as usize * STEPS_PER_POINT;
+    let ds = channel / steps as f64;
+    let (mut x, mut y) = (0.0, 0.0);
+    let mut course = vec![(0.0, 0.0)];
+    for step in 0..steps {
+        let theta = swing * (std::f64::consts::TAU * (step as f64 + 0.5) * ds / wavelength).cos();
+        x += theta.cos() * ds;
+        y += theta.sin() * ds;
+        if (step + 1) % STEPS_PER_POINT == 0 {
+            course.push((x, y));
+        }
+    }
+    // Onto the valley's ends exactly (the integration leaves a little drift).
+    let (end_x, end_y) = *course.last().expect("not empty");
+    // Near its ends the course eases onto the valley line over half a wavelength, so a tributary meets its main
+    // stem along its valley instead of swinging across the other's course.
+    let ease = |x: f64| {
+        let t = (x.min(length - x) / (0.5 * wavelength)).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    };
+    course
+        .iter()
+        .map(|&(x, y)| {
+            let x = x * length / end_x;
+            (x, (y - end_y * x / length) * ease(x))
+        })
+        .collect()
+}
+
+/// How many half wavelengths of about `wavelength` a sine-generated course of `swing` fits along a valley of
+/// `length` (the nearest whole number; 0 where the valley is shorter than a quarter wavelength's channel).
+pub fn half_wavelengths(length: f64, wavelength: f64, swing: f64) -> f64 {
+    (2.0 * length * sinuosity_of(swing) / wavelength).round()
+}
+
 /// Beds that never rise downstream (float rounding in the interpolation could).
 fn monotone(mut beds: Vec<f32>) -> Vec<f32> {
     for i in 1..beds.len() {
@@ -206,7 +232,7 @@ fn monotone(mut beds: Vec<f32>) -> Vec<f32> {
 
 /// The sinuosity of a sine-generated curve of swing `omega`: 1 / J0(omega), the Bessel function as the mean of
 /// cos(omega cos phi) over a period.
-fn sinuosity_of(omega: f64) -> f64 {
+pub fn sinuosity_of(omega: f64) -> f64 {
     const N: usize = 64;
     let mean = (0..N)
         .map(|i| (omega * (std::f64::consts::TAU * (i as f64 + 0.5) / N as f64).cos()).cos())

@@ -30,9 +30,11 @@ pub struct WorldMeasures {
     pub land_height_band_edges: Vec<f64>,
     /// Area-weighted mean height of the land above sea level, in height units.
     pub mean_land_height: f64,
-    /// Median sinuosity of the streams of Strahler order 3 and more (drainage model; NaN otherwise).
+    /// Median sinuosity of the streams of Strahler order 3 and more along their base courses, as the base network
+    /// (and `rivers.geojson`) holds them (drainage model; NaN otherwise). `generate` adds the sinuosity of the
+    /// courses as drawn, with the meanders below the base lattice (`stream_sinuosity_median`).
     #[serde(serialize_with = "finite_or_null")]
-    pub stream_sinuosity_median: f64,
+    pub stream_sinuosity_median_base: f64,
     /// Slope-area concavity of the rivers' profiles (drainage model; NaN otherwise).
     #[serde(serialize_with = "finite_or_null")]
     pub concavity: f64,
@@ -61,7 +63,7 @@ pub fn measure(
     let (bands, mean, land_area) = hypsometry(lattice, sea_level, &edges);
     let (sinuosity, concavity, lakes) = match drainage {
         Some(d) => (
-            profiles::sinuosity_median(&d.reaches, |r| r.points.clone()),
+            profiles::sinuosity_median(&d.reaches, |k| profiles::course_length(&d.reaches[k])),
             profiles::concavity(&d.reaches, radius),
             d.lakes.iter().map(|l| l.area).sum::<f64>() / (land_area * radius * radius),
         ),
@@ -72,7 +74,7 @@ pub fn measure(
         land_height_bands: bands,
         land_height_band_edges: edges,
         mean_land_height: mean,
-        stream_sinuosity_median: sinuosity,
+        stream_sinuosity_median_base: sinuosity,
         concavity,
         lake_land_share: lakes,
     }

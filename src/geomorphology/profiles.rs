@@ -35,23 +35,29 @@ pub fn streams(reaches: &[ReachPath]) -> Vec<Vec<usize>> {
 }
 
 /// Median over the streams of order [`SINUOUS_ORDER`] and more of path length over the chord between its ends
-/// (1 for a straight stream; Leopold and Wolman call a river meandering from 1.5). `path(reach)` gives the
-/// points a reach is drawn along. NaN without such streams.
-pub fn sinuosity_median(
-    reaches: &[ReachPath],
-    path: impl Fn(&ReachPath) -> Vec<glam::DVec3>,
-) -> f64 {
+/// (1 for a straight stream; Leopold and Wolman call a river meandering from 1.5). `length(k)` gives the length
+/// (radians) of reach `k` as it is drawn, e.g. [`course_length`]. NaN without such streams.
+pub fn sinuosity_median(reaches: &[ReachPath], length: impl Fn(usize) -> f64) -> f64 {
     let mut ratios: Vec<f64> = streams(reaches)
         .iter()
         .filter(|chain| reaches[chain[0]].strahler >= SINUOUS_ORDER)
         .filter_map(|chain| {
-            let points: Vec<glam::DVec3> = chain.iter().flat_map(|&r| path(&reaches[r])).collect();
-            let length: f64 = points.windows(2).map(|w| w[0].angle_between(w[1])).sum();
-            let chord = points.first()?.angle_between(*points.last()?);
-            (chord > 1e-9).then(|| length / chord)
+            let first = reaches[chain[0]].points.first()?;
+            let last = reaches[*chain.last()?].points.last()?;
+            let chord = first.angle_between(*last);
+            (chord > 1e-9).then(|| chain.iter().map(|&r| length(r)).sum::<f64>() / chord)
         })
         .collect();
     median(&mut ratios)
+}
+
+/// The length (radians) of a reach along its points.
+pub fn course_length(reach: &ReachPath) -> f64 {
+    reach
+        .points
+        .windows(2)
+        .map(|w| w[0].angle_between(w[1]))
+        .sum()
 }
 
 /// The slope-area concavity theta of S ~ A^-theta: minus the least-squares slope of the mean ln(slope) in bins of
@@ -140,9 +146,9 @@ mod tests {
             .map(|i| DVec3::new(1.0, i as f64 * 0.01, (i % 2) as f64 * 0.01).normalize())
             .collect();
         let reaches = [reach(straight, vec![0.0; 10], vec![1.0; 10], 3)];
-        assert!((sinuosity_median(&reaches, |r| r.points.clone()) - 1.0).abs() < 1e-9);
+        assert!((sinuosity_median(&reaches, |k| course_length(&reaches[k])) - 1.0).abs() < 1e-9);
         let reaches = [reach(zigzag, vec![0.0; 10], vec![1.0; 10], 3)];
-        assert!(sinuosity_median(&reaches, |r| r.points.clone()) > 1.3);
+        assert!(sinuosity_median(&reaches, |k| course_length(&reaches[k])) > 1.3);
         // Order 2 is not measured.
         let reaches = [reach(
             vec![DVec3::X, DVec3::Y],
@@ -150,6 +156,6 @@ mod tests {
             vec![1.0; 2],
             2,
         )];
-        assert!(sinuosity_median(&reaches, |r| r.points.clone()).is_nan());
+        assert!(sinuosity_median(&reaches, |k| course_length(&reaches[k])).is_nan());
     }
 }

@@ -8,8 +8,8 @@ use glam::{DVec2, DVec3};
 use super::{
     spline::Hermite,
     system::{
-        enclose, RiverFrame, RiverSystem, Segment, StreamLevel, SubdivisionParams, MAX_DEPTH,
-        MAX_GENERATION,
+        enclose, meander_wavelength, subdivide, RiverFrame, RiverSystem, Segment, StreamLevel,
+        SubdivisionParams, MAX_DEPTH, MAX_GENERATION,
     },
 };
 use crate::{
@@ -70,7 +70,7 @@ pub fn systems(
         }
     }
     let width = |area: f64| reach_width(config, drainage, area);
-    let branch = |k: usize| rng::hash(params.seed, &[0x6472_6169, k as u64]);
+    let branch = |k: usize| reach_branch(params, k);
     let mut roots: Vec<usize> = (0..reaches.len()).filter(|&k| anchor[k] == k).collect();
     let mouth_area = |k: usize| reaches[k].areas.last().copied().unwrap_or(0.0);
     roots.sort_by(|a, b| mouth_area(*b).total_cmp(&mouth_area(*a)));
@@ -146,6 +146,62 @@ fn reach_segments(
             }
         })
         .collect()
+}
+
+/// The branch key of base reach `k`: its pieces' randomness derives from it.
+fn reach_branch(params: &SubdivisionParams, k: usize) -> u64 {
+    rng::hash(params.seed, &[0x6472_6169, k as u64])
+}
+
+/// The length (radians) of the base reaches that `wanted` accepts as the deepest levels draw them: their pieces
+/// subdivided (5.2.2, with the meanders below the base lattice) until each is at most half a meander wavelength
+/// long, each measured along its curve on the sphere; 0 for the others. The sinuosity geomorphology compares with
+/// rivers measured on maps that show their channels (docs/geomorphology.md).
+pub fn drawn_reach_lengths(
+    (systems, params): (&[RiverSystem], &SubdivisionParams),
+    drainage: &Drainage,
+    wanted: impl Fn(usize) -> bool + Sync,
+) -> Vec<f64> {
+    use rayon::prelude::*;
+    let reach_of: std::collections::HashMap<u64, usize> = (0..drainage.reaches.len())
+        .filter(|&k| wanted(k))
+        .map(|k| (reach_branch(params, k), k))
+        .collect();
+    let lengths: Vec<(usize, f64)> = systems
+        .par_iter()
+        .flat_map_iter(|system| {
+            system.segments.iter().filter_map(|segment| {
+                let k = *reach_of.get(&segment.branch).filter(|_| !segment.lake)?;
+                Some((k, drawn_length(segment, &system.frame, params)))
+            })
+        })
+        .collect();
+    let mut out = vec![0.0; drainage.reaches.len()];
+    for (k, length) in lengths {
+        out[k] += length;
+    }
+    out
+}
+
+/// The length (radians) of `segment` as the deepest levels draw it ([`drawn_reach_lengths`]).
+fn drawn_length(segment: &Segment, frame: &RiverFrame, params: &SubdivisionParams) -> f64 {
+    const POINTS: usize = 4;
+    let mut length = 0.0;
+    let mut stack = vec![*segment];
+    while let Some(piece) = stack.pop() {
+        if piece.depth >= MAX_DEPTH || piece.polygon_length() <= 0.5 * meander_wavelength(&piece) {
+            let points: Vec<DVec3> = (0..POINTS)
+                .map(|i| frame.to_sphere(piece.curve.point(i as f64 / (POINTS - 1) as f64)))
+                .collect();
+            length += points
+                .windows(2)
+                .map(|w| w[0].angle_between(w[1]))
+                .sum::<f64>();
+        } else {
+            stack.extend(subdivide(&piece, params).0);
+        }
+    }
+    length
 }
 
 /// The streams a finer patch `level` adds ([`crate::drainage::streams`]) as river systems, ids from `first_id`:

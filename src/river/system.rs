@@ -14,12 +14,22 @@ use super::{
     spline::{rotate, Hermite},
 };
 use crate::{
-    config::Config,
+    config::{Config, ReliefModel, RiverModel},
+    drainage::meanders,
     rng::{self, Rng},
 };
 
 const STREAM_SUBDIVIDE: u64 = 0x52_0002;
 const STREAM_TRIBUTARY: u64 = 0x52_0003;
+const STREAM_MEANDER: u64 = 0x52_0004;
+/// A piece meanders when its channel holds at most this many half wavelengths (and at least two): pieces shrink
+/// five times a level, so the first piece of a river that is short enough holds more than two.
+const MOST_MEANDER_HALVES: f64 = 10.0;
+/// Knots per meander wavelength of a piece that meanders: Hermite pieces a sixth of a wavelength long, with the
+/// course's own directions at their ends, follow the sine-generated curve to a few thousandths of a wavelength.
+const KNOTS_PER_WAVELENGTH: f64 = 6.0;
+/// Points along a piece's valley line for its arc length.
+const VALLEY_SAMPLES: usize = 64;
 /// Tributaries of tributaries at most.
 pub const MAX_GENERATION: u32 = 2;
 /// Deepest subdivision ever made.
@@ -109,6 +119,10 @@ pub struct SubdivisionParams {
     pub displacement: f64,
     pub tributary_probability: f64,
     pub min_width: f32,
+    /// Beyond the thesis: with the drainage model on eroded relief, the planet's relief over its radius, against
+    /// which a piece's slope sets the swing of the meanders it gets when it is first short enough to hold them
+    /// ([`meander_knots`]); `None`: the thesis's random displacement only.
+    pub meander_relief_slope: Option<f64>,
 }
 
 impl SubdivisionParams {
@@ -119,6 +133,12 @@ impl SubdivisionParams {
             displacement: config.river.displacement as f64,
             tributary_probability: config.river.tributary_probability as f64,
             min_width: config.river.min_width,
+            meander_relief_slope: (config.river.model == RiverModel::Drainage
+                && config.planet.relief_model == ReliefModel::Eroded)
+                .then(|| {
+                    (config.planet.max_mountain_height - config.planet.sea_level_height) as f64
+                        / config.planet.radius as f64
+                }),
         }
     }
 
@@ -135,28 +155,19 @@ impl SubdivisionParams {
 /// and neighbouring pieces share knot and tangent, so the river stays C1. Section 5.2.3: with
 /// `tributary-probability`, a tributary joins at a random inner knot. Deterministic per piece: randomness comes
 /// from the piece's key only.
+///
+/// Beyond the thesis (drainage model on eroded relief, docs/rivers.md "Meanders below the base lattice"): the
+/// first piece of a river short enough to hold its meanders ([`meander_knots`]) is split along a sine-generated
+/// course instead, so rivers narrower than the base lattice resolves meander at the levels that draw them.
 pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>, Option<Segment>) {
-    let m = params.pieces;
-    let mut rng = Rng::new(params.seed, &[STREAM_SUBDIVIDE, segment.key]);
-    let length = segment.polygon_length();
-    let mut knots: Vec<(DVec2, DVec2)> = (0..=m)
-        .map(|k| {
-            let t = k as f64 / m as f64;
-            (
-                segment.curve.point(t),
-                segment.curve.derivative(t) / m as f64,
-            )
-        })
-        .collect();
-    for knot in knots.iter_mut().take(m as usize).skip(1) {
-        let angle = rng.range_f64(0.0, std::f64::consts::TAU);
-        let distance = rng.range_f64(0.0, params.displacement * length / m as f64);
-        knot.0 += DVec2::new(angle.cos(), angle.sin()) * distance;
-        knot.1 = rotate(knot.1, rng.range_f64(-30.0, 30.0).to_radians());
-    }
+    let (knots, at) = match meander_knots(segment, params) {
+        Some(meandering) => meandering,
+        None => displaced_knots(segment, params),
+    };
+    let m = knots.len() as u32 - 1;
     let children: Vec<Segment> = (0..m as usize)
         .map(|k| {
-            let (t0, t1) = (k as f64 / m as f64, (k + 1) as f64 / m as f64);
+            let (t0, t1) = (at[k], at[k + 1]);
             Segment {
                 curve: Hermite {
                     p0: knots[k].0,
@@ -182,7 +193,7 @@ pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>
         let k = (m as usize).div_ceil(2) + trib_rng.below(m as u64 / 2) as usize;
         let k = k.min(m as usize - 1);
         let (junction, flow) = knots[k];
-        let t = k as f64 / m as f64;
+        let t = at[k];
         let width = segment.width_at(t);
         let tributary_length = segment.curve.chord() * t * trib_rng.range_f64(0.8, 1.0);
         let widths = (
@@ -239,6 +250,140 @@ pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>
         })
     });
     (children, tributary.flatten())
+}
+
+/// The knots of a subdivision (positions and tangents) and the parameters of the parent's curve they stand for.
+type Knots = (Vec<(DVec2, DVec2)>, Vec<f64>);
+
+/// Section 5.2.2's knots of `segment` (positions and tangents) and their curve parameters: `pieces` pieces, each
+/// inner knot moved by a random vector of at most `displacement x length / pieces` and its tangent turned by up
+/// to 30 degrees.
+fn displaced_knots(
+    segment: &Segment,
+    params: &SubdivisionParams,
+) -> (Vec<(DVec2, DVec2)>, Vec<f64>) {
+    let m = params.pieces;
+    let mut rng = Rng::new(params.seed, &[STREAM_SUBDIVIDE, segment.key]);
+    let length = segment.polygon_length();
+    let at: Vec<f64> = (0..=m).map(|k| k as f64 / m as f64).collect();
+    let mut knots: Vec<(DVec2, DVec2)> = at
+        .iter()
+        .map(|&t| {
+            (
+                segment.curve.point(t),
+                segment.curve.derivative(t) / m as f64,
+            )
+        })
+        .collect();
+    for knot in knots.iter_mut().take(m as usize).skip(1) {
+        let angle = rng.range_f64(0.0, std::f64::consts::TAU);
+        let distance = rng.range_f64(0.0, params.displacement * length / m as f64);
+        knot.0 += DVec2::new(angle.cos(), angle.sin()) * distance;
+        knot.1 = rotate(knot.1, rng.range_f64(-30.0, 30.0).to_radians());
+    }
+    (knots, at)
+}
+
+/// The wavelength of a river's meanders at `segment` (eleven channel widths; Leopold and Wolman 1960).
+pub fn meander_wavelength(segment: &Segment) -> f64 {
+    meanders::WAVELENGTH_WIDTHS * 0.5 * (segment.widths.0 + segment.widths.1) as f64
+}
+
+/// Beyond the thesis: the knots of `segment` along a sine-generated meandering course about its curve (the
+/// valley line; [`meanders::sine_course`]) and the curve parameters they lie across from, where the segment's
+/// channel holds two to [`MOST_MEANDER_HALVES`] half wavelengths of its river's meanders and its slope leaves
+/// them a swing: the swing falls with the slope as on the base lattice (`meander_relief_slope`), and the
+/// wavelength and swing vary by up to 15 % from piece to piece, and which side the first bend takes, as real
+/// meanders do. The course leaves and joins the valley line along it (the ends and their directions stay, so the
+/// river stays smooth through its neighbours), and deeper pieces are too short to meander again.
+fn meander_knots(segment: &Segment, params: &SubdivisionParams) -> Option<Knots> {
+    let relief_slope = params.meander_relief_slope?;
+    if segment.lake {
+        return None;
+    }
+    let valley = ValleyLine::new(&segment.curve);
+    let length = valley.length();
+    let mut rng = Rng::new(params.seed, &[STREAM_MEANDER, segment.key]);
+    let wavelength = meander_wavelength(segment) * rng.range_f64(0.85, 1.15);
+    let drop = (segment.heights.0 - segment.heights.1).max(0.0) as f64;
+    let swing = meanders::swing_on(drop / length.max(f64::MIN_POSITIVE) / relief_slope)
+        * rng.range_f64(0.85, 1.15);
+    let halves = meanders::half_wavelengths(length, wavelength, swing);
+    if swing < meanders::MIN_SWING || !(2.0..=MOST_MEANDER_HALVES).contains(&halves) {
+        return None;
+    }
+    let side = if rng.unit() < 0.5 { -1.0 } else { 1.0 };
+    // Twice the knots: the points between them give each knot's tangent.
+    let course = meanders::sine_course(length, wavelength, swing, 2.0 * KNOTS_PER_WAVELENGTH);
+    let at: Vec<f64> = course.iter().map(|&(x, _)| valley.parameter(x)).collect();
+    let points: Vec<DVec2> = course
+        .iter()
+        .zip(&at)
+        .map(|(&(_, y), &t)| {
+            let along = segment.curve.derivative(t).normalize_or_zero();
+            segment.curve.point(t) + DVec2::new(-along.y, along.x) * (side * y)
+        })
+        .collect();
+    let last = points.len() - 1;
+    let knots = (0..=last)
+        .step_by(2)
+        .map(|i| {
+            let tangent = match i {
+                0 => {
+                    segment.curve.derivative(0.0).normalize_or_zero()
+                        * 2.0
+                        * points[0].distance(points[1])
+                }
+                i if i == last => {
+                    segment.curve.derivative(1.0).normalize_or_zero()
+                        * 2.0
+                        * points[last - 1].distance(points[last])
+                }
+                i => points[i + 1] - points[i - 1],
+            };
+            (points[i], tangent)
+        })
+        .collect();
+    Some((knots, at.into_iter().step_by(2).collect()))
+}
+
+/// A segment's curve sampled by arc length, as the valley line its meanders swing about.
+struct ValleyLine {
+    /// Arc length at each of [`VALLEY_SAMPLES`] + 1 evenly spaced curve parameters.
+    lengths: Vec<f64>,
+}
+
+impl ValleyLine {
+    fn new(curve: &Hermite) -> Self {
+        let mut lengths = vec![0.0];
+        let mut previous = curve.point(0.0);
+        for k in 1..=VALLEY_SAMPLES {
+            let p = curve.point(k as f64 / VALLEY_SAMPLES as f64);
+            lengths.push(lengths[k - 1] + p.distance(previous));
+            previous = p;
+        }
+        Self { lengths }
+    }
+
+    fn length(&self) -> f64 {
+        self.lengths[VALLEY_SAMPLES]
+    }
+
+    /// The curve parameter at arc length `x`.
+    fn parameter(&self, x: f64) -> f64 {
+        let i = self
+            .lengths
+            .partition_point(|&l| l <= x)
+            .clamp(1, VALLEY_SAMPLES)
+            - 1;
+        let span = self.lengths[i + 1] - self.lengths[i];
+        let t = if span > 0.0 {
+            ((x - self.lengths[i]) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (i as f64 + t) / VALLEY_SAMPLES as f64
+    }
 }
 
 /// A river from a mountain to the sea with all its tributaries.
@@ -371,4 +516,117 @@ pub fn hulls_meet(a: &RiverSystem, b: &RiverSystem) -> bool {
         .map(|p| a.frame.to_plane(b.frame.to_sphere(*p)))
         .collect();
     other.is_none_or(|o| hull::intersects(&a.hull, &o))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A straight piece along x, `length` long and `width` wide, falling by `drop`.
+    fn straight(length: f64, width: f32, drop: f32) -> Segment {
+        let along = DVec2::new(length, 0.0);
+        Segment {
+            curve: Hermite {
+                p0: DVec2::ZERO,
+                d0: along,
+                p1: along,
+                d1: along,
+            },
+            heights: (drop, 0.0),
+            widths: (width, width),
+            key: 7,
+            depth: 0,
+            generation: 0,
+            branch: 7,
+            parent_branch: None,
+            lake: false,
+        }
+    }
+
+    fn params(meanders: bool) -> SubdivisionParams {
+        SubdivisionParams {
+            seed: 3,
+            pieces: 5,
+            displacement: 0.0,
+            tributary_probability: 0.0,
+            min_width: 1.0,
+            meander_relief_slope: meanders.then_some(16.0 / 1024.0),
+        }
+    }
+
+    /// Length along the pieces' curves over the chord.
+    fn sinuosity(pieces: &[Segment]) -> f64 {
+        let length: f64 = pieces
+            .iter()
+            .map(|p| {
+                (0..32)
+                    .map(|i| {
+                        p.curve
+                            .point(i as f64 / 32.0)
+                            .distance(p.curve.point((i + 1) as f64 / 32.0))
+                    })
+                    .sum::<f64>()
+            })
+            .sum();
+        let (first, last) = (pieces[0].curve.p0, pieces[pieces.len() - 1].curve.p1);
+        length / first.distance(last)
+    }
+
+    #[test]
+    fn a_gentle_river_narrower_than_its_piece_meanders_through_it_and_keeps_its_ends() {
+        // Three wavelengths of a river 2 wide (wavelength 22) on a slope of a tenth of the relief slope.
+        let segment = straight(66.0, 2.0, 16.0 / 1024.0 * 66.0 * 0.1);
+        let (children, _) = subdivide(&segment, &params(true));
+        assert!(children.len() > 5, "{} pieces", children.len());
+        assert!(sinuosity(&children) > 1.25, "{}", sinuosity(&children));
+        let (first, last) = (children[0], children[children.len() - 1]);
+        assert_eq!(
+            (first.curve.p0, last.curve.p1),
+            (segment.curve.p0, segment.curve.p1)
+        );
+        // It leaves and joins along its valley, so it stays smooth through its neighbours.
+        assert!(first.curve.d0.normalize().dot(DVec2::X) > 0.9999);
+        assert!(last.curve.d1.normalize().dot(DVec2::X) > 0.9999);
+        // Neighbouring pieces share knot and direction.
+        for w in children.windows(2) {
+            assert_eq!(w[0].curve.p1, w[1].curve.p0);
+            assert!(w[0].curve.d1.normalize().dot(w[1].curve.d0.normalize()) > 0.9999);
+        }
+        // The belt: within a fifth of a wavelength of the valley.
+        let belt = children
+            .iter()
+            .flat_map(|c| (0..=8).map(move |i| c.curve.point(i as f64 / 8.0).y.abs()))
+            .fold(0.0, f64::max);
+        assert!(belt < 0.2 * 22.0 * 1.15, "{belt}");
+        // Beds never rise, and the pieces it made are too short to meander again.
+        assert!(children.iter().all(|c| c.heights.0 >= c.heights.1));
+        for c in &children {
+            assert_eq!(subdivide(c, &params(true)).0.len(), 5);
+        }
+    }
+
+    #[test]
+    fn steep_rivers_rivers_too_long_to_meander_yet_and_the_thesis_keep_its_subdivision() {
+        // A slope of twice the relief slope.
+        let steep = straight(66.0, 2.0, 2.0 * 16.0 / 1024.0 * 66.0);
+        let steep = sinuosity(&subdivide(&steep, &params(true)).0);
+        assert!(steep < 1.01, "{steep}");
+        // Fifty wavelengths: left to the finer pieces.
+        let long = straight(1100.0, 2.0, 0.0);
+        assert_eq!(subdivide(&long, &params(true)).0.len(), 5);
+        let gentle = straight(66.0, 2.0, 0.0);
+        assert!(subdivide(&gentle, &params(true)).0.len() > 5);
+        // Without displacement, the thesis's knots stay on the curve, evenly spaced.
+        let (thesis, _) = subdivide(&gentle, &params(false));
+        assert_eq!(thesis.len(), 5);
+        for (k, piece) in thesis.iter().enumerate() {
+            assert!(
+                piece
+                    .curve
+                    .p0
+                    .distance(DVec2::new(66.0 * k as f64 / 5.0, 0.0))
+                    < 1e-9
+            );
+        }
+    }
 }
