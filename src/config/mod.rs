@@ -142,6 +142,10 @@ pub struct RiverConfig {
     /// Largest random displacement of a knot when a segment is subdivided, as a fraction of segment length / pieces
     /// (5.2.2).
     pub displacement: f32,
+    /// Beyond the thesis, drainage model on eroded relief: rivers too narrow to meander on the base lattice meander
+    /// in the pieces that draw them at finer levels (docs/rivers.md, "Meanders below the base lattice"); `false`:
+    /// the thesis's random displacement only below the base lattice, for comparison.
+    pub fine_meanders: bool,
     /// Directions tried per mountain before it is given up as a river source (5.2.1).
     pub max_attempts: u32,
     /// Samples per half river width (6.4: "three sample points for every distance half the width").
@@ -270,6 +274,7 @@ impl Config {
                 hull_levels: 3,
                 tributary_probability: 0.5,
                 displacement: 0.3,
+                fine_meanders: true,
                 max_attempts: 16,
                 samples_per_half_width: 3,
                 samples_per_vertex_spacing: 0,

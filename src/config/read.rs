@@ -151,6 +151,7 @@ const RIVER: &[Param<RiverConfig>] = &[
     Param::Number("displacement", Range::Closed(0.0, 1.0), |c| {
         &mut c.displacement
     }),
+    Param::Flag("fine-meanders", |c| &mut c.fine_meanders),
     Param::Whole("max-attempts", 1, 1000, |c| &mut c.max_attempts),
     Param::Whole("samples-per-half-width", 1, 16, |c| {
         &mut c.samples_per_half_width

@@ -121,7 +121,7 @@ pub struct SubdivisionParams {
     pub min_width: f32,
     /// Beyond the thesis: with the drainage model on eroded relief, the planet's relief over its radius, against
     /// which a piece's slope sets the swing of the meanders it gets when it is first short enough to hold them
-    /// ([`meander_knots`]); `None`: the thesis's random displacement only.
+    /// ([`meander_knots`]); `None` (other models, or `fine-meanders` off): the thesis's random displacement only.
     pub meander_relief_slope: Option<f64>,
 }
 
@@ -134,7 +134,8 @@ impl SubdivisionParams {
             tributary_probability: config.river.tributary_probability as f64,
             min_width: config.river.min_width,
             meander_relief_slope: (config.river.model == RiverModel::Drainage
-                && config.planet.relief_model == ReliefModel::Eroded)
+                && config.planet.relief_model == ReliefModel::Eroded
+                && config.river.fine_meanders)
                 .then(|| {
                     (config.planet.max_mountain_height - config.planet.sea_level_height) as f64
                         / config.planet.radius as f64
