@@ -28,6 +28,11 @@ const MOST_MEANDER_HALVES: f64 = 10.0;
 /// Knots per meander wavelength of a piece that meanders: Hermite pieces a sixth of a wavelength long, with the
 /// course's own directions at their ends, follow the sine-generated curve to a few thousandths of a wavelength.
 const KNOTS_PER_WAVELENGTH: f64 = 6.0;
+/// Pieces of the first levels of subdivision never meander: a river that would (a wavelength above about a
+/// twentieth of its base segment, two lattice cells) swings across a belt wide enough to reach the rivers that
+/// join it, whose lattice paths converge on the confluence (the default planet's river view showed loops of a
+/// main stem and its tributary overlapping); from this depth on, belts stay within a few hundredths of a cell.
+const FIRST_MEANDER_DEPTH: u32 = 2;
 /// Points along a piece's valley line for its arc length.
 const VALLEY_SAMPLES: usize = 64;
 /// Tributaries of tributaries at most.
@@ -292,14 +297,14 @@ pub fn meander_wavelength(segment: &Segment) -> f64 {
 
 /// Beyond the thesis: the knots of `segment` along a sine-generated meandering course about its curve (the
 /// valley line; [`meanders::sine_course`]) and the curve parameters they lie across from, where the segment's
-/// channel holds two to [`MOST_MEANDER_HALVES`] half wavelengths of its river's meanders and its slope leaves
-/// them a swing: the swing falls with the slope as on the base lattice (`meander_relief_slope`), and the
+/// channel holds two to [`MOST_MEANDER_HALVES`] half wavelengths of its river's meanders, it lies at least
+/// [`FIRST_MEANDER_DEPTH`] deep and its slope leaves them a swing: the swing falls with the slope as on the base lattice (`meander_relief_slope`), and the
 /// wavelength and swing vary by up to 15 % from piece to piece, and which side the first bend takes, as real
 /// meanders do. The course leaves and joins the valley line along it (the ends and their directions stay, so the
 /// river stays smooth through its neighbours), and deeper pieces are too short to meander again.
 fn meander_knots(segment: &Segment, params: &SubdivisionParams) -> Option<Knots> {
     let relief_slope = params.meander_relief_slope?;
-    if segment.lake {
+    if segment.lake || segment.depth < FIRST_MEANDER_DEPTH {
         return None;
     }
     let valley = ValleyLine::new(&segment.curve);
@@ -536,7 +541,7 @@ mod tests {
             heights: (drop, 0.0),
             widths: (width, width),
             key: 7,
-            depth: 0,
+            depth: FIRST_MEANDER_DEPTH,
             generation: 0,
             branch: 7,
             parent_branch: None,
@@ -607,7 +612,7 @@ mod tests {
     }
 
     #[test]
-    fn steep_rivers_rivers_too_long_to_meander_yet_and_the_thesis_keep_its_subdivision() {
+    fn steep_rivers_long_pieces_the_first_levels_and_the_thesis_keep_its_subdivision() {
         // A slope of twice the relief slope.
         let steep = straight(66.0, 2.0, 2.0 * 16.0 / 1024.0 * 66.0);
         let steep = sinuosity(&subdivide(&steep, &params(true)).0);
@@ -617,6 +622,12 @@ mod tests {
         assert_eq!(subdivide(&long, &params(true)).0.len(), 5);
         let gentle = straight(66.0, 2.0, 0.0);
         assert!(subdivide(&gentle, &params(true)).0.len() > 5);
+        // The first levels of subdivision do not meander, however narrow the river.
+        let shallow = Segment {
+            depth: FIRST_MEANDER_DEPTH - 1,
+            ..gentle
+        };
+        assert_eq!(subdivide(&shallow, &params(true)).0.len(), 5);
         // Without displacement, the thesis's knots stay on the curve, evenly spaced.
         let (thesis, _) = subdivide(&gentle, &params(false));
         assert_eq!(thesis.len(), 5);
