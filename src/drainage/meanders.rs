@@ -241,6 +241,22 @@ pub fn sinuosity_of(omega: f64) -> f64 {
     1.0 / mean
 }
 
+/// Where arc length `x` falls along a line sampled at the rising arc `lengths` (at least two): the sample
+/// segment holding it and the share of the way along it.
+pub fn arc_position(lengths: &[f64], x: f64) -> (usize, f64) {
+    let i = lengths
+        .partition_point(|&l| l <= x)
+        .clamp(1, lengths.len() - 1)
+        - 1;
+    let span = lengths[i + 1] - lengths[i];
+    let t = if span > 0.0 {
+        ((x - lengths[i]) / span).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (i, t)
+}
+
 /// A reach's valley line: its lattice path smoothed by a Catmull-Rom spline, sampled by arc length.
 struct Valley {
     /// Points along the line, [`VALLEY_SAMPLES`] per lattice step.
@@ -286,18 +302,7 @@ impl Valley {
 
     /// The sample segment holding arc length `x`, and the share of the way along it.
     fn segment(&self, x: f64) -> (usize, f64) {
-        let i = self
-            .lengths
-            .partition_point(|&l| l <= x)
-            .clamp(1, self.lengths.len() - 1)
-            - 1;
-        let span = self.lengths[i + 1] - self.lengths[i];
-        let t = if span > 0.0 {
-            ((x - self.lengths[i]) / span).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (i, t)
+        arc_position(&self.lengths, x)
     }
 
     /// The point at arc length `x` and the line's direction there.

@@ -377,17 +377,7 @@ impl ValleyLine {
 
     /// The curve parameter at arc length `x`.
     fn parameter(&self, x: f64) -> f64 {
-        let i = self
-            .lengths
-            .partition_point(|&l| l <= x)
-            .clamp(1, VALLEY_SAMPLES)
-            - 1;
-        let span = self.lengths[i + 1] - self.lengths[i];
-        let t = if span > 0.0 {
-            ((x - self.lengths[i]) / span).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
+        let (i, t) = meanders::arc_position(&self.lengths, x);
         (i as f64 + t) / VALLEY_SAMPLES as f64
     }
 }
