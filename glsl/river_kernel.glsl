@@ -94,6 +94,9 @@ struct Accumulators {
     float nearestHalfWidth;
     // Beyond the thesis: the highest level of the lakes whose samples reach the vertex (-FLT_MAX: none).
     float lakeLevel;
+    // Beyond the thesis: how far into that lake's reach the vertex lies from the lake's nearest sample, as the
+    // squared share of the reach (0 on the lake's line, towards 1 at the reach's edge).
+    float lakeOffset2;
     // Beyond the thesis: the unit directions (downstream) of the samples whose river covers the vertex, weighted
     // as their river depth (the water's flow).
     vec2 flowSum;
@@ -101,7 +104,7 @@ struct Accumulators {
 
 Accumulators initAccumulators() {
     return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38,
-                        params.influenceDistance, 0.0, -3.402823466e38, vec2(0.0));
+                        params.influenceDistance, 0.0, -3.402823466e38, 1.0, vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -140,7 +143,15 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
     // part in Procedure 3.
     if (s.halfWidth < 0.0) {
         precise float lakeReach2 = s.halfWidth * s.halfWidth;
-        if (dist2 < lakeReach2) acc.lakeLevel = max(acc.lakeLevel, s.height);
+        if (dist2 < lakeReach2) {
+            float offset2 = dist2 / lakeReach2;
+            if (s.height > acc.lakeLevel) {
+                acc.lakeLevel = s.height;
+                acc.lakeOffset2 = offset2;
+            } else if (s.height == acc.lakeLevel) {
+                acc.lakeOffset2 = min(acc.lakeOffset2, offset2);
+            }
+        }
         return;
     }
     float reach = s.reach;
@@ -193,7 +204,6 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
     float riverWidth = 0.0;
     vec2 flow = vec2(0.0);
     if (acc.weightSum > 0.0) {
-
         float height = acc.heightSum / acc.weightSum;
         float basin = acc.basinSum / acc.weightSum;
         // Beyond the thesis: a vertex nearest to a sample with its own, shorter reach (a finer level's stream) has
@@ -203,22 +213,32 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
             flow = acc.flowSum / acc.inRiverWSum;
             float inRiverBasin = acc.inRiverSum / acc.inRiverWSum;
             float heightOffset = basin - params.basinWaterOffset;
-                    heights = vec4(height + inRiverBasin, 0.0, max(params.seaLevel, height + heightOffset), acc.minDistance);
+            heights = vec4(height + inRiverBasin, 0.0, max(params.seaLevel, height + heightOffset), acc.minDistance);
         } else {
             float terrainHeight = height + basin;
             float divisor = acc.nearestReach - riverWidth;
             float lerpFactor = divisor > 0.0 ? clamp((abs(acc.minDistance) - riverWidth) / divisor, 0.0, 1.0) : 0.0;
-                    heights = vec4(terrainHeight, lerpFactor, max(params.seaLevel, terrainHeight - params.basinWaterOffset),
-                        acc.minDistance);
+            heights = vec4(terrainHeight, lerpFactor, max(params.seaLevel, terrainHeight - params.basinWaterOffset),
+                           acc.minDistance);
         }
     }
     // Beyond the thesis: a vertex a lake reaches, outside every river's basin, gets the lake's level as its
     // water, a distance of 0 and the lake half width, which the shaders read as a basin whose water the mesh shows
-    // where the terrain lies below it (src/kernel/cpu.rs, with_lake).
-    if (acc.lakeLevel > -3.402823466e38 && !acc.inRiver) {
-        heights.z = acc.lakeLevel;
-        heights.w = 0.0;
-        riverWidth = LAKE_HALF_WIDTH;
+    // where the terrain lies below it; in a river's basin, an inflow's water above the level comes down to it
+    // across the lake's reach, its bed with it (src/kernel/cpu.rs, with_lake).
+    if (acc.lakeLevel > -3.402823466e38) {
+        if (acc.inRiver) {
+            float excess = heights.z - acc.lakeLevel;
+            if (excess > 0.0) {
+                precise float drop = excess * (1.0 - acc.lakeOffset2);
+                heights.z -= drop;
+                heights.x -= drop;
+            }
+        } else {
+            heights.z = acc.lakeLevel;
+            heights.w = 0.0;
+            riverWidth = LAKE_HALF_WIDTH;
+        }
     }
     imageStore(riverImages[job.slot], ivec3(xy, 0), heights);
     imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, flow, 0.0));

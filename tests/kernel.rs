@@ -122,8 +122,9 @@ fn lerp_factor_grows_from_bank_to_influence_distance() {
 
 /// Beyond the thesis: a lake's samples (negative width) give the vertices within half their width the lake's
 /// level as water and mark them as in a basin whose water the mesh shows (distance 0, the lake half width), so
-/// the water is drawn where the terrain lies below the level; they carve nothing, and a river's basin keeps its
-/// own water.
+/// the water is drawn where the terrain lies below the level; they carve nothing. A river's basin keeps its own
+/// water where it lies below the level (an outlet); an inflow's water above the level comes down to it across the
+/// lake's reach, its bed with it, so no river's water stands above a lake it flows into.
 #[test]
 fn a_lake_gives_its_level_to_the_vertices_it_reaches() {
     let p = params();
@@ -139,12 +140,44 @@ fn a_lake_gives_its_level_to_the_vertices_it_reaches() {
     // Beyond half its width the lake is not there.
     let beyond = cpu::calculate_height([15.0, 10.0], &[lake], &p);
     assert_eq!(beyond, cpu::calculate_height([15.0, 10.0], &[], &p));
-    // In a river's basin the river's water stays; beside it the lake's level, with the river's lerp factor.
+    // In a river's basin above the lake's level (an inflow), 2.5 into the lake's reach of 4: the water keeps
+    // (2.5 / 4)^2 of its excess over the level, and the bed falls with it.
     let mut both = straight_river();
     both.push(RiverSample::new([10.0, 14.0], [1.0, 0.0], 4.0, -8.0));
     let in_river = cpu::calculate_height([10.0, 16.5], &both, &p);
     let river_only = cpu::calculate_height([10.0, 16.5], &straight_river(), &p);
-    assert_eq!(in_river, river_only);
+    let excess = river_only.water_height - 4.0;
+    assert!(excess > 0.5, "{river_only:?}");
+    let kept = (2.5f32 / 4.0).powi(2);
+    assert!(
+        (in_river.water_height - (4.0 + excess * kept)).abs() < 1e-5,
+        "{in_river:?}"
+    );
+    let drop = river_only.water_height - in_river.water_height;
+    assert!((river_only.terrain_height - in_river.terrain_height - drop).abs() < 1e-5);
+    assert_eq!(
+        (
+            in_river.lerp_factor,
+            in_river.min_distance,
+            in_river.river_width
+        ),
+        (
+            river_only.lerp_factor,
+            river_only.min_distance,
+            river_only.river_width
+        ),
+        "still the river's basin"
+    );
+    // On the lake's line the inflow's water is at the level.
+    let mut lake_line = straight_river();
+    lake_line.push(RiverSample::new([10.0, 16.0], [1.0, 0.0], 4.0, -8.0));
+    let mouth = cpu::calculate_height([10.0, 16.0], &lake_line, &p);
+    assert_eq!(mouth.water_height, 4.0);
+    // A river below the lake's level (an outlet) keeps its water.
+    let mut outlet = straight_river();
+    outlet.push(RiverSample::new([10.0, 14.0], [1.0, 0.0], 7.0, -8.0));
+    assert_eq!(cpu::calculate_height([10.0, 16.5], &outlet, &p), river_only);
+    // Beside the river, the lake's level, with the river's lerp factor.
     let beside = cpu::calculate_height([10.0, 12.0], &both, &p);
     let river_beside = cpu::calculate_height([10.0, 12.0], &straight_river(), &p);
     assert_eq!(beside.water_height, 4.0);

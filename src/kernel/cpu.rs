@@ -135,6 +135,9 @@ pub struct Accumulators {
     /// Beyond the thesis: the highest water level of the lake samples within half their width of the vertex
     /// (`-f32::MAX` where none is).
     pub lake_level: f32,
+    /// Beyond the thesis: how far into that lake's reach the vertex lies from the lake's nearest sample, as the
+    /// squared share of the reach (0 on the lake's line, towards 1 at the reach's edge).
+    pub lake_offset2: f32,
     pub flow_sum: [f32; 2],
 }
 
@@ -157,6 +160,7 @@ pub fn accumulate_height(
         nearest_reach: params.influence_distance,
         nearest_half_width: 0.0,
         lake_level: -f32::MAX,
+        lake_offset2: 1.0,
         flow_sum: [0.0; 2],
     };
     for sample in samples {
@@ -165,8 +169,14 @@ pub fn accumulate_height(
             // squares, as Procedure 3's decisions).
             let r = [v[0] - sample.position[0], v[1] - sample.position[1]];
             let half_width = sample.width * 0.5;
-            if r[0] * r[0] + r[1] * r[1] < half_width * half_width {
-                acc.lake_level = acc.lake_level.max(sample.height);
+            let (dist2, reach2) = (r[0] * r[0] + r[1] * r[1], half_width * half_width);
+            if dist2 < reach2 {
+                let offset2 = dist2 / reach2;
+                if sample.height > acc.lake_level {
+                    (acc.lake_level, acc.lake_offset2) = (sample.height, offset2);
+                } else if sample.height == acc.lake_level {
+                    acc.lake_offset2 = acc.lake_offset2.min(offset2);
+                }
             }
             continue;
         }
@@ -207,9 +217,21 @@ pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelPar
 /// distance of 0 and a half width of [`LAKE_HALF_WIDTH`], which the shaders
 /// read as "in a basin whose water the mesh shows": the water is drawn where the terrain lies below the level, so
 /// the shore is the terrain's contour. The lerp factor stays as the rivers make it, so the terrain is the
-/// planet's own; a river's basin keeps its river's water (an outlet's falls below the level).
+/// planet's own. A river's basin keeps its river's water (an outlet's falls below the level), except that an
+/// inflow's water standing above the level comes down to it across the lake's reach, its bed with it: by the
+/// excess times 1 - `lake_offset2`, so it meets the level on the lake's line and is unchanged at the reach's edge.
 fn with_lake(mut texel: RiverTexel, acc: &Accumulators) -> RiverTexel {
-    if acc.lake_level > -f32::MAX && !acc.in_river {
+    if acc.lake_level == -f32::MAX {
+        return texel;
+    }
+    if acc.in_river {
+        let excess = texel.water_height - acc.lake_level;
+        if excess > 0.0 {
+            let drop = excess * (1.0 - acc.lake_offset2);
+            texel.water_height -= drop;
+            texel.terrain_height -= drop;
+        }
+    } else {
         texel.water_height = acc.lake_level;
         texel.min_distance = 0.0;
         texel.river_width = LAKE_HALF_WIDTH;
