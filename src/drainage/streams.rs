@@ -205,6 +205,8 @@ pub fn new_streams(
 ) -> (Vec<ReachPath>, Vec<Option<Junction>>) {
     let fates: Vec<Fate> = finer.iter().map(|reach| fate(reach, drawn, rule)).collect();
     // A reach is drawn if it joins a course with something of its own, or flows into the sea or into a drawn reach.
+    // One that starts on a course is drawn only as the mouth of streams that meet there (they reach it first: the
+    // finer network lists its reaches upstream first).
     let mut kept: Vec<Option<bool>> = vec![None; finer.len()];
     for start in 0..finer.len() {
         let mut chain = Vec::new();
@@ -215,6 +217,7 @@ pub fn new_streams(
             }
             chain.push(at);
             match fates[at] {
+                Fate::Joins { at: 0, course } if !course.lake => break chain.len() > 1,
                 Fate::Joins { at: i, course } => break i > usize::from(course.lake),
                 Fate::Left => break false,
                 Fate::Flows => match finer[at].downstream {
@@ -318,6 +321,13 @@ fn fate(reach: &ReachPath, drawn: &Courses, rule: &StreamRule) -> Fate {
             let beside = !course.lake
                 && d <= rule.valley
                 && before.is_some_and(|(q, was)| d > was - APPROACH * p.distance(q));
+            // Streams that meet where they reach a river join it together, as the stream they make: the reach
+            // below their confluence joins it from its first point (else each would join on its own, and the
+            // confluence's order would be lost from the network as drawn).
+            let confluence = i + 1 == reach.points.len() && reach.downstream.is_some();
+            if joins && confluence && !course.lake {
+                return Fate::Flows;
+            }
             if joins || beside {
                 return Fate::Joins { at: i, course };
             }
@@ -330,4 +340,76 @@ fn fate(reach: &ReachPath, drawn: &Courses, rule: &StreamRule) -> Fate {
         }
     }
     Fate::Flows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A point `east` radians east and `north` radians north of (1, 0, 0).
+    fn at(east: f64, north: f64) -> DVec3 {
+        DVec3::new(1.0, east, north).normalize()
+    }
+
+    fn reach(points: Vec<DVec3>, strahler: u32, downstream: Option<usize>) -> ReachPath {
+        let n = points.len();
+        ReachPath {
+            beds: (0..n).map(|i| 10.0 - i as f32).collect(),
+            areas: vec![1.0; n],
+            points,
+            strahler,
+            downstream,
+        }
+    }
+
+    /// A drawn river along the equator, joined within 0.01.
+    fn equator() -> (Courses, StreamRule) {
+        let river = reach(vec![at(-0.2, 0.0), at(0.2, 0.0)], 2, None);
+        let mut courses = Courses::new(0.05);
+        courses.add_reaches(&[river], 0.001, |_| 0.0005);
+        let rule = StreamRule {
+            coarser_source_area: 100.0,
+            sea_level: -1.0,
+            join: 0.01,
+            valley: 0.0,
+        };
+        (courses, rule)
+    }
+
+    #[test]
+    fn streams_that_meet_on_a_river_join_it_as_the_stream_they_make() {
+        // Two streams come down from the north and meet 0.005 from the river (within the join distance), where
+        // the reach below them starts.
+        let (courses, rule) = equator();
+        let confluence = at(0.0, 0.005);
+        let finer = vec![
+            reach(
+                vec![at(-0.05, 0.1), at(-0.02, 0.05), confluence],
+                1,
+                Some(2),
+            ),
+            reach(vec![at(0.05, 0.1), at(0.02, 0.05), confluence], 1, Some(2)),
+            reach(vec![confluence, at(0.0, 0.0)], 2, None),
+        ];
+        let (streams, joins) = new_streams(&finer, &courses, &rule);
+        assert_eq!(streams.len(), 3, "both streams and the one they make");
+        assert_eq!(streams[0].downstream, Some(2));
+        assert_eq!(streams[1].downstream, Some(2));
+        assert_eq!(
+            (joins[0], joins[1]),
+            (None, None),
+            "they flow on into the stream they make"
+        );
+        let mouth = joins[2].expect("the stream they make joins the river");
+        assert_eq!(mouth.reach, 0);
+        assert!((mouth.at - 0.5).abs() < 0.01, "where they meet: {mouth:?}");
+        assert_eq!(streams[2].points[0], confluence);
+    }
+
+    #[test]
+    fn a_reach_that_starts_on_a_river_is_a_copy_of_it() {
+        let (courses, rule) = equator();
+        let copy = vec![reach(vec![at(-0.1, 0.002), at(0.1, 0.002)], 1, None)];
+        assert!(new_streams(&copy, &courses, &rule).0.is_empty());
+    }
 }
