@@ -46,7 +46,8 @@ float periodicNoise(vec3 x, float period) {
 // coarser octaves of 4, 16 and 64 units take over, each fading out again once its cells pass 128 pixels: without
 // them a planet in metres showed one flat colour from a kilometre up. A view that resolves the unit octave looks
 // as it did. In [0, 1], 0.5 where nothing shows.
-// Coordinates: fDetail, the world position modulo DETAIL_PERIOD (precise near the camera at any planet size).
+// Coordinates: fDetail, the world position modulo a multiple of GROUND_DETAIL_PERIOD (precise near the camera at any
+// planet size).
 float groundDetail() {
     // About 1.4 to 2 pixels' size on the surface.
     float footprint = length(fwidth(fDetail));
@@ -56,14 +57,14 @@ float groundDetail() {
     for (int k = 0; k < 3; ++k, amplitude *= 0.6, size *= 0.25) {
         float fade = 1.0 - smoothBand(0.35, 0.7, footprint / size);
         if (fade <= 0.0) break;
-        sum += amplitude * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
+        sum += amplitude * fade * (periodicNoise(fDetail / size, GROUND_DETAIL_PERIOD / size) - 0.5);
     }
     float coarse = smoothBand(0.35, 0.7, footprint);
     size = 4.0;
     for (int k = 0; k < 3 && coarse > 0.0; ++k, size *= 4.0) {
         float pixels = size / max(footprint, 1e-6);
         float fade = coarse * (1.0 - smoothBand(0.35, 0.7, 1.0 / pixels)) * (1.0 - smoothBand(128.0, 1024.0, pixels));
-        sum += 0.4 * fade * (periodicNoise(fDetail / size, DETAIL_PERIOD / size) - 0.5);
+        sum += 0.4 * fade * (periodicNoise(fDetail / size, GROUND_DETAIL_PERIOD / size) - 0.5);
     }
     return clamp(0.5 + sum / 1.4, 0.0, 1.0);
 }
@@ -190,9 +191,11 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
 
 // The fragment in ripple sizes (rivers: the river's half width; the sea: a unit of colour band, extra.z) and how
 // much ripples show: they fade where one is smaller than a pixel, and still water has none. Takes derivatives.
+// From fDetail, small near the camera: the direction times the radius in f32 put an Earth river's ripples 0.4 m
+// apart, a tenth of a ripple on a narrow one, and broke them into streaks.
 vec3 rippleSpace(bool river, out float visible) {
     float size = river ? max(fRiver.w, 0.02) : frame.extra.z;
-    vec3 q = fDirection * (frame.planet.x / size);
+    vec3 q = fDetail / size;
     visible = stillWater() ? 0.0 : 1.0 - smoothBand(0.4, 1.2, length(fwidth(q)));
     return q;
 }

@@ -44,7 +44,7 @@ struct PatchInstance {
     vec4 morph;       // x: share of the switch distance where morphing towards the parent starts; y: 1 / the
                       // morph band's share; zw: the patch's vertex (0, 0) in its parent's river texture
     vec4 switchDistances; // at the corners (0, 0), (n-1, 0), (0, n-1), (n-1, n-1); bilinear between them
-    vec4 detail;      // xyz: the patch centre's world position modulo DETAIL_PERIOD (computed in f64)
+    vec4 detail;      // xyz: the patch centre's world position modulo 65536 (computed in f64; render/frame/shader_data.rs)
 };
 
 // Whether a vertex of `surface` (terrain height, water height, signed distance, half width) lies in a river's
@@ -58,8 +58,9 @@ float smoothBand(float e0, float e1, float x) {
     return t * t * (3.0 - 2.0 * t);
 }
 
-// The period of the ground detail's coordinates (render/frame/draw.rs, DETAIL_PERIOD).
-const float DETAIL_PERIOD = 256.0;
+// The ground detail's lattices repeat every 256 units, which divides the period of its coordinates (fDetail,
+// render/frame/shader_data.rs, DETAIL_PERIOD).
+const float GROUND_DETAIL_PERIOD = 256.0;
 
 layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance instances[]; };
 // Where the terrain pass puts every vertex when frame.extra.w is 1 (tests): per instance and mesh vertex, the

@@ -158,7 +158,8 @@ pub struct PatchInstance {
     pub morph: [f32; 4],
     /// The switch distances at the patch's corners (0,0), (1,0), (0,1), (1,1) (`LodParams::switch_distances`).
     pub switch_distances: [f32; 4],
-    /// xyz: the patch centre's world position modulo DETAIL_PERIOD; w: its vertex cache entry, or -1.
+    /// xyz: the patch centre's world position reduced modulo DETAIL_PERIOD (render/frame/shader_data.rs); w: its
+    /// vertex cache entry, or -1.
     pub detail: [f32; 4],
 }
 

@@ -165,6 +165,27 @@ fn widths_must_be_positive() {
 }
 
 #[test]
+fn the_interior_rise_lies_between_0_and_20() {
+    for bad in ["-0.5", "21", "1e30"] {
+        let msg = error_of(&with("planet-attributes", "interior-rise", bad));
+        assert!(
+            msg.contains("<interior-rise>") && msg.contains("[0, 20]"),
+            "{msg}"
+        );
+    }
+    let earth =
+        Config::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml"))
+            .unwrap();
+    assert_eq!(earth.planet.interior_rise, 2.5);
+    assert_eq!(
+        Config::defaults_for(RiverModel::Drainage)
+            .planet
+            .interior_rise,
+        0.0
+    );
+}
+
+#[test]
 fn landmass_must_lie_strictly_between_0_and_100() {
     for bad in ["0", "100", "-1", "150.0f"] {
         let msg = error_of(&with("planet-attributes", "landmass-percentage", bad));

@@ -67,6 +67,9 @@ pub struct PlanetConfig {
     pub base_resolution: u32,
     /// How the relief is made (the thesis's square mountains, or the drainage model's carved or eroded relief).
     pub relief_model: ReliefModel,
+    /// Eroded relief (beyond the thesis): the lowlands' uplift grows inland by this share of itself per radian
+    /// from the sea, so continental interiors stand higher than their coastal plains (0: one lowland uplift).
+    pub interior_rise: f32,
 }
 
 /// How the land gets its relief.
@@ -259,6 +262,7 @@ impl Config {
                 detail_amplitude: 8.0,
                 base_resolution: 129,
                 relief_model: ReliefModel::Thesis,
+                interior_rise: 0.0,
             },
             river: RiverConfig {
                 model: RiverModel::Thesis,

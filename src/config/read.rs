@@ -126,6 +126,9 @@ const PLANET: &[Param<PlanetConfig>] = &[
     }),
     Param::Grid("base-resolution", 9, 1025, |c| &mut c.base_resolution),
     Param::Choice("relief-model", |c, text| choose(text, &mut c.relief_model)),
+    Param::Number("interior-rise", Range::Closed(0.0, 20.0), |c| {
+        &mut c.interior_rise
+    }),
 ];
 
 /// `<river-attributes>`.

@@ -78,7 +78,7 @@ pub fn raise(
     let sea_level = planet.sea_level_height as f64;
     let land = relief::land_of(lattice, grid, sea_level);
     let CoastDistances { to_sea, to_land } = CoastDistances::new(grid, &land);
-    let uplift = uplift(grid, &land, &to_sea, seed);
+    let uplift = uplift(grid, &land, &to_sea, planet.interior_rise as f64, seed);
     let erodibility = erodibility(grid, seed);
     let (eroded, report) = evolve(grid, &land, &uplift, &erodibility, seed);
     let peak = quantile(
@@ -100,9 +100,15 @@ pub fn raise(
     report
 }
 
-/// Tectonic uplift per land node (0 at sea): low over coastal plains and lowlands, higher on plateaus, highest
-/// along mountain belts.
-fn uplift(grid: &SphereGrid, land: &[bool], to_sea: &[f64], seed: u64) -> Vec<f64> {
+/// Tectonic uplift per land node (0 at sea): low over coastal plains and lowlands (rising inland by
+/// `interior_rise` of itself per radian from the sea), higher on plateaus, highest along mountain belts.
+fn uplift(
+    grid: &SphereGrid,
+    land: &[bool],
+    to_sea: &[f64],
+    interior_rise: f64,
+    seed: u64,
+) -> Vec<f64> {
     let belts_seed = rng::hash(seed, &[STREAM_BELTS]);
     let plateaus_seed = rng::hash(seed, &[STREAM_PLATEAUS]);
     let warp_seed = rng::hash(seed, &[STREAM_WARP]);
@@ -127,7 +133,8 @@ fn uplift(grid: &SphereGrid, land: &[bool], to_sea: &[f64], seed: u64) -> Vec<f6
                 noise::fbm(plateaus_seed, warped, PLATEAU_FREQUENCY, 3),
             );
             let inland = 1.0 - (-to_sea[k] / COASTAL_PLAIN).exp();
-            inland * (LOWLAND_UPLIFT + PLATEAU_UPLIFT * plateau + BELT_UPLIFT * belt * belt)
+            let lowland = LOWLAND_UPLIFT * (1.0 + interior_rise * to_sea[k]);
+            inland * (lowland + PLATEAU_UPLIFT * plateau + BELT_UPLIFT * belt * belt)
         })
         .collect()
 }

@@ -115,20 +115,28 @@ pub(super) fn instance(
         morph: NO_MORPH,
         switch_distances: [1.0; 4],
         detail: [
-            (centre.x * radius).rem_euclid(DETAIL_PERIOD) as f32,
-            (centre.y * radius).rem_euclid(DETAIL_PERIOD) as f32,
-            (centre.z * radius).rem_euclid(DETAIL_PERIOD) as f32,
+            detail_coordinate(centre.x * radius),
+            detail_coordinate(centre.y * radius),
+            detail_coordinate(centre.z * radius),
             0.0,
         ],
     }
 }
 
-/// The period in world units of the fragment shader's ground detail: patch centres are reduced modulo it in f64, so
-/// the detail's coordinates stay small (precise to 0.02 mm) at any planet size, and the finest octave's lattice
-/// (4096 cells) stays within what the shader's cheap float hash resolves; every octave's lattice divides it, so
-/// neighbouring patches agree although their centres wrap differently. The detail repeats every 256 units (metres
-/// on config/earth.xml), under terrain that does not.
-const DETAIL_PERIOD: f64 = 256.0;
+/// The period in world units of the fragment shader's detail coordinates (the ground's detail and the water's
+/// ripples): patch centres are reduced modulo it in f64, into [-P/2, P/2), so the coordinates stay small at any
+/// planet size: precise to 4 mm at most, where the absolute positions in f32 were 0.4 m apart on an Earth-sized
+/// planet (ripples a few metres across, on its narrow rivers, broke into streaks). Every lattice of the ground detail
+/// (256 units, terrain.frag) divides it, so neighbouring patches agree although their centres wrap differently; the
+/// ripples, whose size follows the river's width, change pattern where a coordinate wraps: planes 65.5 km apart on
+/// config/earth.xml, none on a planet whose coordinates stay within the half period (the default planet's radius is
+/// 1,024).
+const DETAIL_PERIOD: f64 = 65536.0;
+
+/// A patch centre's world coordinate reduced to [-DETAIL_PERIOD / 2, DETAIL_PERIOD / 2).
+fn detail_coordinate(x: f64) -> f32 {
+    ((x + DETAIL_PERIOD / 2.0).rem_euclid(DETAIL_PERIOD) - DETAIL_PERIOD / 2.0) as f32
+}
 
 /// Morph parameters that never morph (the level-0 patches, and the thesis's instant switching): a band of no
 /// length beyond any distance.
