@@ -8,8 +8,8 @@ use crate::{
     gpu::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
-        Access, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc, ImageUse,
-        MemoryLocation, Recorder,
+        Access, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc, MemoryLocation,
+        Recorder,
     },
     planet::{cube::PatchId, detail::PatchHeights, Planet},
     shader_types::{GpuRefineJob, RefinePush},
@@ -181,14 +181,7 @@ impl HeightRefiner {
 
 /// Moves fresh base-height textures to GENERAL, ready for uploads and for the refinement shader's writes.
 pub fn prepare_height_textures(rec: &mut Recorder, images: &[&Image]) {
-    rec.image_barriers(
-        images,
-        ImageUse {
-            before: &[Access::Nothing],
-            after: &[Access::TransferWrite, Access::ComputeWrite],
-            discard: true,
-        },
-    );
+    rec.overwrite_images(images, &[Access::TransferWrite, Access::ComputeWrite]);
 }
 
 /// Creates one patch's base-height texture: `(n + 2 BORDER)^2` texels, written by upload (precomputed levels)

@@ -5,8 +5,8 @@ mod common;
 use riverplanet::{
     gpu::{
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
-        Access, Buffer, BufferDesc, Context, Extent2D, Format, ImageDesc, ImageUse, MemoryLocation,
-        Profiler, Recorder,
+        Access, Buffer, BufferDesc, Context, Extent2D, Format, ImageDesc, MemoryLocation, Profiler,
+        Recorder,
     },
     shaders,
 };
@@ -233,14 +233,7 @@ fn dropped_buffers_and_images_are_kept_or_freed_once_the_gpu_is_done() {
     assert_eq!(ctx.live_allocations(), before + 2);
     let mut rec = riverplanet::gpu::Recorder::begin(&ctx, "fill before drop").unwrap();
     rec.fill_buffer(&buffer, 7);
-    rec.image_barriers(
-        &[&image],
-        ImageUse {
-            before: &[Access::Nothing],
-            after: &[Access::TransferWrite],
-            discard: true,
-        },
-    );
+    rec.overwrite_images(&[&image], &[Access::TransferWrite]);
     let submitted = rec.submit().unwrap();
     drop(buffer);
     drop(image);
@@ -268,4 +261,61 @@ fn dropped_buffers_and_images_are_kept_or_freed_once_the_gpu_is_done() {
     ctx.release_recycled();
     assert_eq!(ctx.recycled_objects(), 0);
     assert_eq!(ctx.live_allocations(), before);
+}
+
+/// Issue "One way to use the GPU": an image remembers what it was last recorded for, so a caller names only the
+/// next use. An upload, a copy out, a second upload over it and a second copy, across two submissions: each copy
+/// reads what was uploaded just before it, and synchronization validation finds no hazard (a barrier that forgot
+/// the upload would let the copy read before the write, from a layout that discards it).
+#[test]
+fn images_carry_their_last_use_from_barrier_to_barrier() {
+    let Some(ctx) = common::gpu_with_synchronization_validation() else {
+        return;
+    };
+    let image = ctx
+        .create_image(&ImageDesc {
+            name: "tracked image",
+            extent: Extent2D {
+                width: 8,
+                height: 8,
+            },
+            layers: 1,
+            format: Format::R32_SFLOAT,
+            // An attachment's usage: not shader-visible, so each use has its own layout (gpu/access.rs).
+            uses: &[
+                Access::ColorAttachment,
+                Access::TransferWrite,
+                Access::TransferRead,
+            ],
+            array: false,
+        })
+        .unwrap();
+    let readback = ctx
+        .create_buffer(&BufferDesc {
+            name: "tracked image readback",
+            size: 2 * 64 * 4,
+            uses: &[Access::TransferWrite, Access::HostRead],
+            location: MemoryLocation::GpuToCpu,
+        })
+        .unwrap();
+    let texels = |k: f32| (0..64).map(|i| i as f32 + k).collect::<Vec<f32>>();
+    let round = |rec: &mut Recorder, k: f32, offset: u64| {
+        rec.overwrite_images(&[&image], &[Access::TransferWrite]);
+        rec.upload_image_layer(&image, 0, bytemuck::cast_slice(&texels(k)))?;
+        rec.use_images(&[&image], &[Access::TransferRead]);
+        rec.copy_image_to_buffer(&image, &readback, offset);
+        Ok(())
+    };
+    ctx.run_and_wait("first round", |rec| round(rec, 0.0, 0))
+        .unwrap();
+    ctx.run_and_wait("second round", |rec| {
+        round(rec, 1000.0, 256)?;
+        rec.buffer_barrier(&readback, &[Access::TransferWrite], &[Access::HostRead]);
+        Ok(())
+    })
+    .unwrap();
+    let read: &[f32] = bytemuck::cast_slice(readback.mapped().unwrap());
+    assert_eq!(&read[..64], &texels(0.0)[..]);
+    assert_eq!(&read[64..], &texels(1000.0)[..]);
+    common::assert_no_validation_errors(ctx);
 }

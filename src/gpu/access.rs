@@ -196,7 +196,7 @@ pub(crate) fn buffer_barrier(
 /// What happens to an image at a barrier: the uses before and after it, and whether its contents may be
 /// discarded (they are then not kept through the layout change: an image about to be cleared or overwritten).
 #[derive(Clone, Copy, Debug)]
-pub struct ImageUse<'a> {
+pub(crate) struct ImageUse<'a> {
     pub before: &'a [Access],
     pub after: &'a [Access],
     pub discard: bool,

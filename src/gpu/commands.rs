@@ -7,6 +7,7 @@ use ash::vk;
 use super::{
     access::{self, Access, ImageUse},
     pipeline::{Attachment, ComputePipeline, GraphicsPipeline, RenderTarget},
+    state::UseState,
     Buffer, BufferDesc, GpuError, Image, MemoryLocation, Recorder,
 };
 
@@ -128,12 +129,29 @@ impl Recorder<'_> {
         self.pipeline_barrier(&vk::DependencyInfo::default().memory_barriers(&barrier));
     }
 
-    /// Barriers of every subresource of each of `images` for `usage`.
-    pub fn image_barriers(&mut self, images: &[&Image], usage: ImageUse) {
+    /// Makes each of `images` ready for `uses`, after the uses it was last recorded for (gpu/state.rs), keeping
+    /// its contents.
+    pub fn use_images(&mut self, images: &[&Image], uses: &[Access]) {
+        self.transition_images(images, uses, false);
+    }
+
+    /// Makes each of `images` ready for `uses`, discarding its contents: an image about to be written whole.
+    pub fn overwrite_images(&mut self, images: &[&Image], uses: &[Access]) {
+        self.transition_images(images, uses, true);
+    }
+
+    fn transition_images(&mut self, images: &[&Image], uses: &[Access], discard: bool) {
         let barriers: Vec<_> = images
             .iter()
             .map(|image| {
-                access::image_barrier(image.raw, image.range(), image.shader_visible(), &usage)
+                transition(
+                    image.raw,
+                    image.range(),
+                    image.shader_visible(),
+                    &image.state,
+                    uses,
+                    discard,
+                )
             })
             .collect();
         if !barriers.is_empty() {
@@ -141,23 +159,33 @@ impl Recorder<'_> {
         }
     }
 
-    /// A barrier of one of `target`'s attachments (whose colour image may be a swapchain's, not one of our
-    /// [`Image`]s), for `usage`.
-    pub fn attachment_barrier(
+    /// Makes `which` attachment of `target` (whose colour image may be a swapchain's, not one of our [`Image`]s)
+    /// ready for `uses`, after the uses it was last recorded for; `discard`: its contents are not kept (it is
+    /// about to be cleared).
+    pub fn use_attachment(
         &mut self,
         target: &RenderTarget,
         which: Attachment,
-        usage: ImageUse,
+        uses: &[Access],
+        discard: bool,
     ) {
-        let (image, aspect) = match which {
-            Attachment::Color => (target.color_image, vk::ImageAspectFlags::COLOR),
-            Attachment::Depth => (target.depth_image, vk::ImageAspectFlags::DEPTH),
+        let (image, aspect, state) = match which {
+            Attachment::Color => (
+                target.color_image,
+                vk::ImageAspectFlags::COLOR,
+                &target.color_state,
+            ),
+            Attachment::Depth => (
+                target.depth_image,
+                vk::ImageAspectFlags::DEPTH,
+                &target.depth_state,
+            ),
         };
         let range = vk::ImageSubresourceRange::default()
             .aspect_mask(aspect)
             .level_count(1)
             .layer_count(1);
-        let barrier = [access::image_barrier(image, range, false, &usage)];
+        let barrier = [transition(image, range, false, state, uses, discard)];
         self.pipeline_barrier(&vk::DependencyInfo::default().image_memory_barriers(&barrier));
     }
 
@@ -376,4 +404,26 @@ fn whole_layers(image: &Image, first: u32, count: u32, offset: u64) -> vk::Buffe
             height: image.extent.height,
             depth: 1,
         })
+}
+
+/// The barrier of `image` from the uses `state` last recorded to `uses`, which it records.
+fn transition(
+    image: vk::Image,
+    range: vk::ImageSubresourceRange,
+    shader_visible: bool,
+    state: &UseState,
+    uses: &[Access],
+    discard: bool,
+) -> vk::ImageMemoryBarrier2<'static> {
+    let before = state.replace(uses);
+    access::image_barrier(
+        image,
+        range,
+        shader_visible,
+        &ImageUse {
+            before: &before,
+            after: uses,
+            discard,
+        },
+    )
 }

@@ -10,6 +10,7 @@ pub use gpu_allocator::MemoryLocation;
 use super::{
     access::{self, Access},
     retire::{BufferMemory, BufferShape, DeletionQueue, ImageMemory, ImageShape, Retired},
+    state::UseState,
     Context, GpuError, VkResultExt,
 };
 
@@ -109,6 +110,8 @@ pub struct Image {
     allocation: Option<Allocation>,
     shape: ImageShape,
     deletion: Arc<DeletionQueue>,
+    /// What it was last recorded for (gpu/state.rs).
+    pub(super) state: Arc<UseState>,
 }
 
 impl Drop for Image {
@@ -271,6 +274,7 @@ impl Context {
             allocation: Some(memory.allocation),
             shape,
             deletion: self.deletion.clone(),
+            state: UseState::fresh(),
         })
     }
 

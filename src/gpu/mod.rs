@@ -24,10 +24,11 @@ pub mod overlay;
 pub mod pipeline;
 pub mod profiler;
 pub mod retire;
+mod state;
 pub mod submit;
 pub mod swapchain;
 
-pub use access::{Access, ImageUse};
+pub use access::Access;
 pub use adapter::AdapterInfo;
 /// The plain Vulkan value types the layers above describe resources and frames with; they name no flags and call
 /// no Vulkan (synchronisation and usage are said in [`Access`]es).

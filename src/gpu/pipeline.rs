@@ -1,9 +1,12 @@
 //! Shader modules, compute pipelines and small descriptor sets of storage buffers.
 
+use std::sync::Arc;
+
 use ash::vk;
 
 use super::{
     retire::{RetireOnDrop, Retired},
+    state::UseState,
     Context, GpuError, Image, VkResultExt,
 };
 
@@ -346,13 +349,16 @@ impl GraphicsPipeline {
 }
 
 /// The attachments of one rendering pass: a colour image (one of our [`Image`]s, or a swapchain's image, which is
-/// not) and a depth image, made by [`RenderTarget::new`] or [`super::swapchain::Swapchain::target`].
-#[derive(Clone, Copy, Debug)]
+/// not) and a depth image, made by [`RenderTarget::new`] or [`super::swapchain::Swapchain::target`]; each
+/// attachment shares its image's state (gpu/state.rs).
+#[derive(Clone, Debug)]
 pub struct RenderTarget {
     pub(super) color_image: vk::Image,
     pub(super) color_view: vk::ImageView,
+    pub(super) color_state: Arc<UseState>,
     pub(super) depth_image: vk::Image,
     pub(super) depth_view: vk::ImageView,
+    pub(super) depth_state: Arc<UseState>,
     pub(super) extent: vk::Extent2D,
     pub(super) clear_color: [f32; 4],
 }
@@ -370,8 +376,10 @@ impl RenderTarget {
         Self {
             color_image: color.raw,
             color_view: color.view,
+            color_state: color.state.clone(),
             depth_image: depth.raw,
             depth_view: depth.view,
+            depth_state: depth.state.clone(),
             extent: color.extent,
             clear_color,
         }

@@ -1,12 +1,14 @@
 //! Presentation to a window: the surface, the swapchain with its image views, and acquire/present with binary
 //! semaphores. Out-of-date and suboptimal swapchains are reported so the caller can recreate them (resize).
 
-use std::ffi::CStr;
+use std::{ffi::CStr, sync::Arc};
 
 use ash::{khr, vk};
 use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
 
-use super::{pipeline::RenderTarget, Context, GpuError, Image, VkResultExt};
+use super::{
+    pipeline::RenderTarget, state::UseState, Access, Context, GpuError, Image, VkResultExt,
+};
 
 /// The instance extensions a window on `display` needs.
 pub fn surface_extensions(display: RawDisplayHandle) -> Result<Vec<&'static CStr>, GpuError> {
@@ -62,6 +64,8 @@ pub struct Swapchain {
     raw: vk::SwapchainKHR,
     images: Vec<vk::Image>,
     views: Vec<vk::ImageView>,
+    /// What each image was last recorded for (gpu/state.rs).
+    states: Vec<Arc<UseState>>,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     /// Acquire semaphores, used in turn: one more than the most frames in flight, so the one acquired next is never
@@ -76,12 +80,18 @@ pub const SWAPCHAIN_FORMAT: vk::Format = vk::Format::B8G8R8A8_UNORM;
 
 impl Swapchain {
     /// The target of a frame drawn into image `index` (from `acquire`) with `depth`, cleared to `clear_color`.
+    /// The image comes back from the presentation engine with its contents undefined, and the acquire semaphore is
+    /// waited for at colour output: its first barrier waits there.
     pub fn target(&self, index: u32, depth: &Image, clear_color: [f32; 4]) -> RenderTarget {
+        let state = self.states[index as usize].clone();
+        state.set(&[Access::ColorAttachment]);
         RenderTarget {
             color_image: self.images[index as usize],
             color_view: self.views[index as usize],
+            color_state: state,
             depth_image: depth.raw,
             depth_view: depth.view,
+            depth_state: depth.state.clone(),
             extent: self.extent,
             clear_color,
         }
@@ -176,6 +186,7 @@ impl Swapchain {
         Ok(Self {
             loader,
             raw,
+            states: images.iter().map(|_| UseState::fresh()).collect(),
             images,
             views,
             format: format.format,

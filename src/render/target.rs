@@ -2,7 +2,7 @@
 
 use crate::gpu::{
     pipeline::RenderTarget, Access, BufferDesc, Context, Extent2D, Format, GpuError, Image,
-    ImageDesc, ImageUse, MemoryLocation, Recorder,
+    ImageDesc, MemoryLocation, Recorder,
 };
 
 pub const COLOR_FORMAT: Format = Format::R8G8B8A8_UNORM;
@@ -54,24 +54,10 @@ impl Offscreen {
             location: MemoryLocation::GpuToCpu,
         })?;
         let result = ctx.run_and_wait("read offscreen colour", |rec: &mut Recorder| {
-            rec.image_barriers(
-                &[&self.color],
-                ImageUse {
-                    before: &[Access::ColorAttachment],
-                    after: &[Access::TransferRead],
-                    discard: false,
-                },
-            );
+            rec.use_images(&[&self.color], &[Access::TransferRead]);
             rec.copy_image_to_buffer(&self.color, &buffer, 0);
             rec.buffer_barrier(&buffer, &[Access::TransferWrite], &[Access::HostRead]);
-            rec.image_barriers(
-                &[&self.color],
-                ImageUse {
-                    before: &[Access::TransferRead],
-                    after: &[Access::ColorAttachment],
-                    discard: false,
-                },
-            );
+            rec.use_images(&[&self.color], &[Access::ColorAttachment]);
             Ok(())
         });
         let image = result.and_then(|()| {

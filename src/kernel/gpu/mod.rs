@@ -19,7 +19,7 @@ use crate::{
         bindless::{Bindless, Slot},
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
         Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc,
-        ImageUse, MemoryLocation, Recorder,
+        MemoryLocation, Recorder,
     },
     shader_types::{KernelPush, TiledConstants},
     shaders,
@@ -141,14 +141,7 @@ impl RiverKernel {
         batch: &KernelBatch,
         params: &KernelParams,
     ) -> Result<u64, GpuError> {
-        rec.image_barriers(
-            batch.textures,
-            ImageUse {
-                before: &[Access::Nothing],
-                after: &[Access::ComputeWrite],
-                discard: true,
-            },
-        );
+        rec.overwrite_images(batch.textures, &[Access::ComputeWrite]);
         if batch.jobs.is_empty() {
             return Ok(0);
         }

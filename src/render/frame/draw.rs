@@ -15,7 +15,7 @@ use super::{
 use crate::{
     gpu::{
         pipeline::{Attachment, RenderTarget},
-        Access, Buffer, BufferDesc, GpuError, ImageUse, MemoryLocation, Recorder,
+        Access, Buffer, BufferDesc, GpuError, MemoryLocation, Recorder,
     },
     planet::cube::{PatchId, EDGES},
     runtime::{camera::Camera, lod::Selected},
@@ -349,24 +349,8 @@ impl Renderer<'_> {
         rec.free_after_completion(vertex_cache);
         // The target is cleared, so its contents are discarded; the wait for the earlier writes to it (the frame
         // before, which may still be in flight, or the swapchain's acquire, waited for at colour output) stays.
-        rec.attachment_barrier(
-            target,
-            Attachment::Color,
-            ImageUse {
-                before: &[Access::ColorAttachment],
-                after: &[Access::ColorAttachment],
-                discard: true,
-            },
-        );
-        rec.attachment_barrier(
-            target,
-            Attachment::Depth,
-            ImageUse {
-                before: &[Access::DepthAttachment],
-                after: &[Access::DepthAttachment],
-                discard: true,
-            },
-        );
+        rec.use_attachment(target, Attachment::Color, &[Access::ColorAttachment], true);
+        rec.use_attachment(target, Attachment::Depth, &[Access::DepthAttachment], true);
         rec.begin_rendering(target, true);
         let scope = self.frames.profiler().begin(rec, "terrain")?;
         for (indices, instances, cull) in terrain_draws {
@@ -419,15 +403,7 @@ impl Renderer<'_> {
         }
         rec.end_rendering();
         if after != Access::ColorAttachment {
-            rec.attachment_barrier(
-                target,
-                Attachment::Color,
-                ImageUse {
-                    before: &[Access::ColorAttachment],
-                    after: &[after],
-                    discard: false,
-                },
-            );
+            rec.use_attachment(target, Attachment::Color, &[after], false);
         }
         Ok(Drawn {
             capture,

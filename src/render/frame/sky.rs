@@ -7,7 +7,7 @@ use crate::{
         bindless::{Bindless, Slot},
         pipeline::{Blend, ComputePipeline, GraphicsDesc, GraphicsPipeline},
         Access, Buffer, BufferDesc, Context, DescriptorSet, DescriptorSetLayout, Extent2D, Format,
-        GpuError, Image, ImageDesc, ImageUse, MemoryLocation, Recorder,
+        GpuError, Image, ImageDesc, MemoryLocation, Recorder,
     },
     planet::atmosphere::Atmosphere,
     render::mesh::{dome_mesh, index_buffer},
@@ -62,23 +62,9 @@ impl Sky {
             array: true,
         })?;
         ctx.run_and_wait("upload atmosphere transmittance", |rec| {
-            rec.image_barriers(
-                &[&image],
-                ImageUse {
-                    before: &[Access::Nothing],
-                    after: &[Access::TransferWrite],
-                    discard: true,
-                },
-            );
+            rec.overwrite_images(&[&image], &[Access::TransferWrite]);
             rec.upload_image_layer(&image, 0, bytemuck::cast_slice(&table.texels))?;
-            rec.image_barriers(
-                &[&image],
-                ImageUse {
-                    before: &[Access::TransferWrite],
-                    after: &[Access::GraphicsSampled],
-                    discard: false,
-                },
-            );
+            rec.use_images(&[&image], &[Access::GraphicsSampled]);
             Ok(())
         })?;
         let indices = dome_mesh(RINGS, SEGMENTS);
