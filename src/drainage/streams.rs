@@ -323,9 +323,10 @@ fn fate(reach: &ReachPath, drawn: &Courses, rule: &StreamRule) -> Fate {
                 && before.is_some_and(|(q, was)| d > was - APPROACH * p.distance(q));
             // Streams that meet where they reach a river join it together, as the stream they make: the reach
             // below their confluence joins it from its first point (else each would join on its own, and the
-            // confluence's order would be lost from the network as drawn).
+            // confluence's order would be lost from the network as drawn). Not where they meet in the river's
+            // water: the reach below would have no length to the bank.
             let confluence = i + 1 == reach.points.len() && reach.downstream.is_some();
-            if joins && confluence && !course.lake {
+            if joins && confluence && !course.lake && d > course.half_width {
                 return Fate::Flows;
             }
             if joins || beside {
@@ -404,6 +405,35 @@ mod tests {
         assert_eq!(mouth.reach, 0);
         assert!((mouth.at - 0.5).abs() < 0.01, "where they meet: {mouth:?}");
         assert_eq!(streams[2].points[0], confluence);
+    }
+
+    #[test]
+    fn streams_that_meet_in_the_river_join_it_each_with_a_mouth_of_some_length() {
+        // The confluence lies on a point of the river's line (a finer lattice point on a coarser course): the reach
+        // below it would have no length to the bank (no direction for the kernel: NaN heights), so each stream
+        // joins on its own.
+        let (courses, rule) = equator();
+        let confluence = at(-0.2, 0.0);
+        let finer = vec![
+            reach(
+                vec![at(-0.25, 0.1), at(-0.22, 0.05), confluence],
+                1,
+                Some(2),
+            ),
+            reach(
+                vec![at(-0.15, 0.1), at(-0.18, 0.05), confluence],
+                1,
+                Some(2),
+            ),
+            reach(vec![confluence, at(-0.19, -0.001)], 2, None),
+        ];
+        let (streams, joins) = new_streams(&finer, &courses, &rule);
+        assert_eq!(streams.len(), 2, "each stream joins on its own");
+        assert!(joins.iter().all(Option::is_some));
+        for stream in &streams {
+            let length: f64 = stream.points.windows(2).map(|w| w[0].distance(w[1])).sum();
+            assert!(length > 0.01, "a stream of length {length}");
+        }
     }
 
     #[test]
