@@ -142,6 +142,7 @@ impl HeightRefiner {
             bytes: ranges.size,
             buffer: ranges,
         };
+        rec.use_buffer(&out.buffer, &[Access::ComputeWrite]);
         let mut start = 0;
         while start < jobs.len() {
             let level = jobs[start].patch.level;
@@ -174,7 +175,7 @@ impl HeightRefiner {
             set?;
             start = end;
         }
-        rec.buffer_barrier(&out.buffer, &[Access::ComputeWrite], &[Access::HostRead]);
+        rec.use_buffer(&out.buffer, &[Access::HostRead]);
         Ok(Some(out))
     }
 }
@@ -320,15 +321,21 @@ pub fn generate_on_gpu(
         }
         rec.memory_barrier(&[Access::TransferWrite], &[Access::ComputeSampled]);
         let ranges = refiner.record(rec, bindless_ref, planet, &jobs)?;
-        rec.memory_barrier(&[Access::ComputeWrite], &[Access::TransferRead]);
-        for (k, p) in patches.iter().enumerate() {
-            let index = all
-                .iter()
-                .position(|q| q == p)
-                .expect("every wanted patch is made");
-            rec.copy_image_to_buffer(&images[index], &readback, k as u64 * texel_bytes);
+        let wanted: Vec<&Image> = patches
+            .iter()
+            .map(|p| {
+                let index = all
+                    .iter()
+                    .position(|q| q == p)
+                    .expect("every wanted patch is made");
+                &images[index]
+            })
+            .collect();
+        rec.use_images(&wanted, &[Access::TransferRead]);
+        for (k, image) in wanted.iter().enumerate() {
+            rec.copy_image_to_buffer(image, &readback, k as u64 * texel_bytes);
         }
-        rec.buffer_barrier(&readback, &[Access::TransferWrite], &[Access::HostRead]);
+        rec.use_buffer(&readback, &[Access::HostRead]);
         Ok(ranges)
     });
     let out = result.and_then(|ranges| {

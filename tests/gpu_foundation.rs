@@ -81,13 +81,13 @@ fn objects_dropped_while_a_recording_uses_them_live_until_it_has_run() {
     let push: [u32; 3] = [2.0f32.to_bits(), 1.0f32.to_bits(), COUNT];
     let mut rec = Recorder::begin(ctx, "drop while recorded").unwrap();
     let set = rec.buffer_set(&sets, &[&out]).unwrap();
+    rec.use_buffer(&out, &[Access::ComputeWrite]);
     rec.dispatch(
         &pipeline,
         &[set],
         bytemuck::cast_slice(&push),
         [COUNT.div_ceil(64), 1, 1],
     );
-    rec.buffer_barrier(&out, &[Access::ComputeWrite], &[Access::TransferRead]);
     rec.copy_buffer(&out, &readback, COUNT as u64 * 4);
     let before = ctx.retired_objects();
     drop(pipeline);
@@ -131,6 +131,7 @@ fn compute_dispatch_reads_back_and_is_timed() {
     ctx.run_and_wait("fill", |rec| {
         let set = rec.buffer_set(&sets, &[&out])?;
         let scope = profiler.begin(rec, "fill kernel")?;
+        rec.use_buffer(&out, &[Access::ComputeWrite]);
         rec.dispatch(
             &pipeline,
             &[set],
@@ -138,7 +139,6 @@ fn compute_dispatch_reads_back_and_is_timed() {
             [COUNT.div_ceil(64), 1, 1],
         );
         profiler.end(rec, scope);
-        rec.buffer_barrier(&out, &[Access::ComputeWrite], &[Access::TransferRead]);
         rec.copy_buffer(&out, &readback, size);
         Ok(())
     })
@@ -310,7 +310,7 @@ fn images_carry_their_last_use_from_barrier_to_barrier() {
         .unwrap();
     ctx.run_and_wait("second round", |rec| {
         round(rec, 1000.0, 256)?;
-        rec.buffer_barrier(&readback, &[Access::TransferWrite], &[Access::HostRead]);
+        rec.use_buffer(&readback, &[Access::HostRead]);
         Ok(())
     })
     .unwrap();

@@ -44,6 +44,7 @@ impl Recorder<'_> {
             )));
         }
         let src = self.stage(&dst.name, data)?;
+        self.use_buffer(dst, &[Access::TransferWrite]);
         let region = vk::BufferCopy::default()
             .dst_offset(offset)
             .size(data.len() as u64);
@@ -53,7 +54,7 @@ impl Recorder<'_> {
                 .device
                 .cmd_copy_buffer(self.cmd, src, dst.raw, &[region])
         };
-        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::AnyShaderRead]);
+        self.use_buffer(dst, &[Access::AnyShaderRead]);
         Ok(())
     }
 
@@ -78,8 +79,9 @@ impl Recorder<'_> {
     }
 
     /// Copies the whole of `src` (in its layout for [`Access::TransferRead`]) into `dst` at `offset`, layer after
-    /// layer, tightly packed.
+    /// layer, tightly packed (a transfer write of `dst`: [`Self::use_buffer`]).
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        self.use_buffer(dst, &[Access::TransferWrite]);
         let layout = Access::TransferRead.layout(src.shader_visible());
         let region = whole_layers(src, 0, src.layers, offset);
         // SAFETY: the layout is the caller's contract (the barrier before); both objects outlive the submission.
@@ -92,6 +94,8 @@ impl Recorder<'_> {
 
     /// Copies the first `size` bytes of `src` to `dst`, then makes them visible to the host.
     pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size: u64) {
+        self.use_buffer(src, &[Access::TransferRead]);
+        self.use_buffer(dst, &[Access::TransferWrite]);
         let region = vk::BufferCopy::default().size(size);
         // SAFETY: both buffers outlive the submission.
         unsafe {
@@ -99,11 +103,13 @@ impl Recorder<'_> {
                 .device
                 .cmd_copy_buffer(self.cmd, src.raw, dst.raw, &[region])
         };
-        self.buffer_barrier(dst, &[Access::TransferWrite], &[Access::HostRead]);
+        self.use_buffer(dst, &[Access::HostRead]);
     }
 
-    /// Fills all of `buffer` with the `u32` `value` (for buffers the GPU accumulates into, e.g. with atomics).
+    /// Fills all of `buffer` with the `u32` `value` (for buffers the GPU accumulates into, e.g. with atomics): a
+    /// transfer write of it ([`Self::use_buffer`]).
     pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
+        self.use_buffer(buffer, &[Access::TransferWrite]);
         // SAFETY: recording; the buffer outlives the submission and has TRANSFER_DST usage (validated).
         unsafe {
             self.ctx.device.cmd_fill_buffer(
@@ -116,9 +122,17 @@ impl Recorder<'_> {
         };
     }
 
-    /// A barrier between the uses `before` and `after` of `buffer` (gpu/access.rs).
-    pub fn buffer_barrier(&mut self, buffer: &Buffer, before: &[Access], after: &[Access]) {
-        let barrier = [access::buffer_barrier(buffer.raw, before, after)];
+    /// Declares the uses the next commands make of `buffer`, with a barrier from the uses it was last declared for
+    /// (gpu/state.rs). Fills and copies declare their own; a dispatch that writes a buffer needs its
+    /// [`Access::ComputeWrite`] declared before it. No barrier follows a fresh buffer (nothing to wait for) or the
+    /// same uses declared again: commands of one use in a row run without barriers between them, so writes in a row
+    /// must touch separate ranges (copies into a readback at their offsets).
+    pub fn use_buffer(&mut self, buffer: &Buffer, uses: &[Access]) {
+        let before = buffer.state.replace(uses);
+        if before == [Access::Nothing] || before == uses {
+            return;
+        }
+        let barrier = [access::buffer_barrier(buffer.raw, &before, uses)];
         self.pipeline_barrier(&vk::DependencyInfo::default().buffer_memory_barriers(&barrier));
     }
 

@@ -32,6 +32,8 @@ pub struct Buffer {
     allocation: Option<Allocation>,
     shape: BufferShape,
     deletion: Arc<DeletionQueue>,
+    /// What it was last declared for (gpu/state.rs).
+    pub(super) state: Arc<UseState>,
 }
 
 impl Drop for Buffer {
@@ -209,6 +211,7 @@ impl Context {
             allocation: Some(memory.allocation),
             shape: memory.shape,
             deletion: self.deletion.clone(),
+            state: UseState::fresh(),
         })
     }
 

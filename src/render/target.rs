@@ -56,7 +56,7 @@ impl Offscreen {
         let result = ctx.run_and_wait("read offscreen colour", |rec: &mut Recorder| {
             rec.use_images(&[&self.color], &[Access::TransferRead]);
             rec.copy_image_to_buffer(&self.color, &buffer, 0);
-            rec.buffer_barrier(&buffer, &[Access::TransferWrite], &[Access::HostRead]);
+            rec.use_buffer(&buffer, &[Access::HostRead]);
             rec.use_images(&[&self.color], &[Access::ColorAttachment]);
             Ok(())
         });

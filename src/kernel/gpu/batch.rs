@@ -164,11 +164,11 @@ pub fn run_batch_into(
         let scope = profiler.begin(rec, "kernel")?;
         let bytes = kernel.record(rec, bindless, variant, &batch, params)?;
         profiler.end(rec, scope);
-        rec.memory_barrier(&[Access::ComputeWrite], &[Access::TransferRead]);
+        rec.use_images(&image_refs, &[Access::TransferRead]);
         for (k, image) in images.iter().enumerate() {
             rec.copy_image_to_buffer(image, readback, k as u64 * texel_bytes);
         }
-        rec.buffer_barrier(readback, &[Access::TransferWrite], &[Access::HostRead]);
+        rec.use_buffer(readback, &[Access::HostRead]);
         Ok(bytes)
     });
     let outcome = result.and_then(|temporary_bytes| {

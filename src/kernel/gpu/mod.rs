@@ -238,12 +238,7 @@ impl RiverKernel {
         let set = rec.buffer_set(&self.tiled_inputs, &[samples, table_buffer, &masks]);
         if let Ok(set) = set {
             rec.fill_buffer(&masks, 0);
-            // ALL_TRANSFER: the spec puts fills in the CLEAR stage, older validation layers in COPY.
-            rec.buffer_barrier(
-                &masks,
-                &[Access::TransferWrite],
-                &[Access::ComputeRead, Access::ComputeWrite],
-            );
+            rec.use_buffer(&masks, &[Access::ComputeRead, Access::ComputeWrite]);
             let rows = table.rows.len() as u32;
             rec.dispatch(
                 &self.reach,
@@ -251,7 +246,7 @@ impl RiverKernel {
                 bytemuck::bytes_of(&push(0)),
                 [1, rows, 1],
             );
-            rec.buffer_barrier(&masks, &[Access::ComputeWrite], &[Access::ComputeRead]);
+            rec.use_buffer(&masks, &[Access::ComputeRead]);
             for (first, count, [x, y]) in groups.into_iter().filter(|g| g.1 > 0) {
                 let size = [x.div_ceil(bx), y.div_ceil(by), count as u32];
                 let push = push(first);

@@ -298,12 +298,7 @@ impl Renderer<'_> {
                 location: MemoryLocation::GpuToCpu,
             })?;
             rec.fill_buffer(&buffer, 0);
-            // ALL_TRANSFER: the spec puts fills in the CLEAR stage, older validation layers in COPY.
-            rec.buffer_barrier(
-                &buffer,
-                &[Access::TransferWrite],
-                &[Access::VertexShaderWrite],
-            );
+            rec.use_buffer(&buffer, &[Access::VertexShaderWrite]);
             Some(buffer)
         } else {
             None

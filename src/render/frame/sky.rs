@@ -134,17 +134,14 @@ impl Sky {
         (sets, push): (&[DescriptorSet], &[u8]),
         vertices: &Buffer,
     ) {
+        rec.use_buffer(vertices, &[Access::ComputeWrite]);
         rec.dispatch(
             &self.dome_pipeline,
             sets,
             push,
             [DOME_VERTICES.div_ceil(WORKGROUP), 1, 1],
         );
-        rec.buffer_barrier(
-            vertices,
-            &[Access::ComputeWrite],
-            &[Access::VertexShaderRead],
-        );
+        rec.use_buffer(vertices, &[Access::VertexShaderRead]);
     }
 
     /// Draws the sky (inside the frame's rendering scope).

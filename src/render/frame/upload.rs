@@ -174,7 +174,7 @@ impl Renderer<'_> {
                 .kernel
                 .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
             self.frames.profiler().end(rec, scope);
-            rec.memory_barrier(&[Access::ComputeWrite], &[Access::GraphicsSampled]);
+            rec.use_images(&textures, &[Access::GraphicsSampled]);
         }
         let river_count = rivers.len();
         let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();

@@ -121,17 +121,14 @@ impl VertexCache {
         if patches == 0 {
             return;
         }
+        rec.use_buffer(cache, &[Access::ComputeWrite]);
         rec.dispatch(
             &self.pipeline,
             sets,
             push,
             [(n * n).div_ceil(WORKGROUP), patches as u32, 1],
         );
-        rec.buffer_barrier(
-            cache,
-            &[Access::ComputeWrite],
-            &[Access::ComputeRead, Access::VertexShaderRead],
-        );
+        rec.use_buffer(cache, &[Access::ComputeRead, Access::VertexShaderRead]);
         if !water_pass {
             return;
         }
