@@ -40,7 +40,15 @@ fn main() -> anyhow::Result<()> {
     let level = 7;
     let region = Region::new([lon - 1.0, lat - 1.0, lon + 1.0, lat + 1.0], level)
         .map_err(anyhow::Error::msg)?;
-    let surface = sample_region(&world.planet, &world.network, &config, level, &region);
+    // The patches are carved in parallel; the last argument hears of each one done (progress).
+    let surface = sample_region(
+        &world.planet,
+        &world.network,
+        &config,
+        level,
+        &region,
+        &|_| {},
+    );
     let metadata = planet_metadata(&world.planet, seed, level, true);
     let planet = (world.planet.radius, world.planet.sea_level);
     let (terrain, water) = write_glb(out.as_ref(), &region, &surface, planet, &metadata)?;

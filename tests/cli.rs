@@ -1341,3 +1341,37 @@ fn a_stopped_generate_leaves_the_old_planet_whole() {
         .count();
     assert_eq!(hidden, 0, "a half-written set is left");
 }
+
+/// Issue "Your own terrain, your own program": a long command says on a terminal what it is doing and how long is
+/// left (here under `script`, which gives it one), and nothing when its standard error is piped.
+#[test]
+fn exports_show_progress_on_a_terminal_only() {
+    let dir = temp_dir("progress");
+    let out = dir.join("faces");
+    let command = format!(
+        "{} export faces --seed 1 --level 3 --out {}",
+        env!("CARGO_BIN_EXE_riverplanet"),
+        out.display()
+    );
+    let Ok(on_terminal) = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+    else {
+        eprintln!("skipped: no `script` (util-linux) to give the command a terminal");
+        return;
+    };
+    assert!(on_terminal.status.success());
+    let shown = String::from_utf8_lossy(&on_terminal.stdout);
+    assert!(
+        shown.contains("carving the patches of level 3") && shown.contains("left"),
+        "{shown}"
+    );
+    let piped = riverplanet()
+        .args(["export", "faces", "--seed", "1", "--level", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(piped.status.success());
+    let said = String::from_utf8_lossy(&piped.stderr);
+    assert!(!said.contains("carving"), "progress on a pipe: {said}");
+}

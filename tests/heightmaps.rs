@@ -230,7 +230,7 @@ fn the_equirectangular_geotiff_is_georeferenced_and_holds_the_carved_heights() {
     assert_eq!(sidecar["sea_level"], metadata["sea_level"]);
 
     let world = default_world();
-    let carved = carved_terrain(&world.planet, &world.network, &world.config, 4);
+    let carved = carved_terrain(&world.planet, &world.network, &world.config, 4, &|_| {});
     let lon_lat_of = |x: f64, y: f64| (-180.0 + (x + 0.5) * 0.5, 90.0 - (y + 0.5) * 0.5);
     for y in (0..360).step_by(7) {
         for x in (0..720).step_by(5) {
@@ -628,6 +628,7 @@ fn the_exported_surface_is_the_surface_the_renderer_draws() {
         &world.planet,
         &world.network,
         &world.config,
+        &|| {},
     );
     let n = world.config.rendering.vertices;
     let radius = world.planet.radius;

@@ -116,7 +116,6 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             summary_only,
             csv,
         } => {
-            use std::io::IsTerminal;
             let (config, _) = load_config(planet.config.as_deref())?;
             for (argument, path) in [("--json", Some(&json)), ("--csv", csv.as_ref())] {
                 if let Some(path) = path {
@@ -143,9 +142,8 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 ..options.clone()
             })?;
             let world = riverplanet::world::World::build(&config, planet.seed)?;
-            let bar = std::io::stderr()
-                .is_terminal()
-                .then(|| indicatif::ProgressBar::new(frames as u64));
+            let progress = super::progress::Progress::start("flight");
+            progress.count("flight", frames as u64);
             let options = bench::flight::FlightOptions {
                 frames,
                 stress,
@@ -166,14 +164,10 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 water_in_mesh: water_in_mesh.on(),
             };
             let report = bench::flight::flight_bench(&ctx, &world, &options, |mode, frame| {
-                if let Some(bar) = &bar {
-                    bar.set_message(mode.to_string());
-                    bar.set_position(frame as u64 + 1);
-                }
+                progress.say(mode.to_string());
+                progress.set(frame as u64 + 1);
             })?;
-            if let Some(bar) = bar {
-                bar.finish_and_clear();
-            }
+            drop(progress);
             let s = &report.summary;
             println!(
                 "{} frames at {}x{} on {}{}: {:.1} ms/frame average ({:.1} fps), median {:.1}, max {:.1}",

@@ -14,7 +14,7 @@ use riverplanet::{
     world::World,
 };
 
-use super::{ExportCommand, RegionFormat};
+use super::{progress::Progress, ExportCommand, RegionFormat};
 use crate::{load_config, planet_seed, usage};
 
 /// The finest level `export rivers` refines the thesis's river pieces to (as `hull-levels`' range).
@@ -32,9 +32,10 @@ pub fn export(what: ExportCommand) -> anyhow::Result<()> {
             export::files::check_folder("--out", &out).map_err(usage)?;
             let (config, _) = load_config(planet.config.as_deref())?;
             let seed = planet_seed(planet.seed, &config);
-            let world = World::build(&config, seed)?;
-            let lattice = carved_terrain(&world.planet, &world.network, &config, level);
+            let progress = Progress::start("building the planet");
+            let (world, lattice) = carved_world(&config, seed, level, &progress)?;
             let metadata = planet_metadata(&world.planet, seed, level, true);
+            progress.stage("writing the faces");
             // The faces and layout.json replace the folder's old set as a whole, or not at all.
             let set = export::files::OutputSet::begin(&out)?;
             let layout = write_faces(&lattice, format, set.path(), &metadata)?;
@@ -73,9 +74,10 @@ pub fn export(what: ExportCommand) -> anyhow::Result<()> {
             }
             let (config, _) = load_config(planet.config.as_deref())?;
             let seed = planet_seed(planet.seed, &config);
-            let world = World::build(&config, seed)?;
-            let lattice = carved_terrain(&world.planet, &world.network, &config, level);
+            let progress = Progress::start("building the planet");
+            let (world, lattice) = carved_world(&config, seed, level, &progress)?;
             let metadata = planet_metadata(&world.planet, seed, level, true);
+            progress.stage(format!("sampling and writing {width} x {height}"));
             let written = write_equirect(
                 &lattice,
                 (width, height),
@@ -140,8 +142,17 @@ fn export_region(
     }
     let (config, _) = load_config(planet.config.as_deref())?;
     let seed = planet_seed(planet.seed, &config);
+    let progress = Progress::start("building the planet");
     let world = World::build(&config, seed)?;
-    let surface = sample_region(&world.planet, &world.network, &config, level, &region);
+    let surface = sample_region(
+        &world.planet,
+        &world.network,
+        &config,
+        level,
+        &region,
+        &counter(&progress, format!("carving the patches of level {level}")),
+    );
+    drop(progress);
     let metadata = planet_metadata(&world.planet, seed, level, true);
     let (width, height) = region.size;
     match format {
@@ -169,6 +180,34 @@ fn export_region(
         }
     }
     Ok(())
+}
+
+/// The planet of `config` and `seed` and its terrain carved at `level`, counted by `progress`.
+fn carved_world(
+    config: &riverplanet::config::Config,
+    seed: u32,
+    level: u32,
+    progress: &Progress,
+) -> anyhow::Result<(World, riverplanet::planet::heights::FaceLattice)> {
+    let world = World::build(config, seed)?;
+    let message = format!("carving the patches of level {level}");
+    let lattice = carved_terrain(
+        &world.planet,
+        &world.network,
+        config,
+        level,
+        &counter(progress, message),
+    );
+    Ok((world, lattice))
+}
+
+/// A step of `progress` per patch carved, counting the total the first call gives.
+fn counter(progress: &Progress, message: String) -> impl Fn(usize) + Sync + '_ {
+    let started = std::sync::Once::new();
+    move |total| {
+        started.call_once(|| progress.count(message.clone(), total as u64));
+        progress.step();
+    }
 }
 
 fn check_level(level: u32) -> anyhow::Result<()> {

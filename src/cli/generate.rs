@@ -15,7 +15,6 @@ pub fn generate(
     (preview, equirect): (bool, bool),
     level: Option<u32>,
 ) -> anyhow::Result<()> {
-    use std::io::IsTerminal;
     let (config, source) = load_config(config_path)?;
     let deepest = config
         .rendering
@@ -32,21 +31,11 @@ pub fn generate(
         )));
     }
     let seed = planet_seed(seed, &config);
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new_spinner();
-        bar.enable_steady_tick(std::time::Duration::from_millis(100));
-        Some(bar)
-    } else {
-        None
-    };
+    let progress = super::progress::Progress::start("planet");
     let planet = riverplanet::planet::Planet::generate(&config, seed, |stage| {
-        if let Some(bar) = &bar {
-            bar.set_message(stage.to_string());
-        }
+        progress.stage(stage.to_string());
     })?;
-    if let Some(bar) = &bar {
-        bar.set_message("rivers");
-    }
+    progress.stage("rivers");
     let t = std::time::Instant::now();
     let network = riverplanet::river::network::RiverNetwork::generate(&planet, &config, seed);
     let river_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -54,9 +43,7 @@ pub fn generate(
     let geojson_depth = config.river.hull_levels;
     let (rivers, tributaries) = network.count(geojson_depth);
     let t = std::time::Instant::now();
-    if let Some(bar) = &bar {
-        bar.set_message("writing");
-    }
+    progress.stage("writing");
     // Everything below replaces the folder's old set as a whole, or not at all.
     let set = riverplanet::export::files::OutputSet::begin(out)?;
     let dir = set.path();
@@ -153,8 +140,5 @@ pub fn generate(
         serde_json::to_string_pretty(&value)?.as_bytes(),
     )?;
     set.commit()?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
     Ok(())
 }

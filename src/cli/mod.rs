@@ -4,6 +4,7 @@
 pub mod benchmarks;
 pub mod export;
 pub mod generate;
+pub mod progress;
 pub mod render;
 
 use std::path::PathBuf;

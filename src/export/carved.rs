@@ -24,12 +24,14 @@ pub const MAX_EXPORT_LEVEL: u32 = 7;
 
 /// Terrain heights (above the sphere of the planet's radius, with the river beds) of every vertex of `level`, one
 /// lattice per face: point (i, j) of face f is the direction of cube point u = -1 + 2 i / cells, v = -1 + 2 j /
-/// cells ([`FaceLattice`]).
+/// cells ([`FaceLattice`]). `carved` is called with the number of patches to carve as each one is done (from any
+/// thread: progress).
 pub fn carved_terrain(
     planet: &Planet,
     network: &RiverNetwork,
     config: &Config,
     level: u32,
+    carved: &(dyn Fn(usize) + Sync),
 ) -> FaceLattice {
     let n = config.rendering.vertices;
     let params = KernelParams::from_config(config);
@@ -46,15 +48,17 @@ pub fn carved_terrain(
                 y: k / count,
             })
             .collect();
-        let carved: Vec<CarvedPatch> = patches
+        let surfaces: Vec<CarvedPatch> = patches
             .par_iter()
             .map(|&patch| {
                 let (x0, y0) = detail::origin(patch, n);
                 let base = |i: u32, j: u32| lattice.get(face, x0 as u32 + i, y0 as u32 + j);
-                carve_patch(patch, base, planet, network, n, &params)
+                let surface = carve_patch(patch, base, planet, network, n, &params);
+                carved(FACES * (count * count) as usize);
+                surface
             })
             .collect();
-        for CarvedPatch { patch, terrain, .. } in carved {
+        for CarvedPatch { patch, terrain, .. } in surfaces {
             let (x0, y0) = detail::origin(patch, n);
             for (k, h) in terrain.into_iter().enumerate() {
                 let (i, j) = (x0 as u32 + k as u32 % n, y0 as u32 + k as u32 / n);

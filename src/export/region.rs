@@ -97,12 +97,14 @@ pub struct RegionSurface {
 
 /// Samples `region` from the carved patches of `level` that contain its pixels' centres, bilinear between each
 /// patch's vertices. A pixel on a face edge reads one face's patch (they can differ there; docs/exports.md).
+/// `carved` is called with the number of patches to carve as each one is done (from any thread: progress).
 pub fn sample_region(
     planet: &Planet,
     network: &RiverNetwork,
     config: &Config,
     level: u32,
     region: &Region,
+    carved: &(dyn Fn(usize) + Sync),
 ) -> RegionSurface {
     let (width, height) = region.size;
     let pixels: Vec<(DVec3, PatchId)> = (0..width * height)
@@ -115,7 +117,8 @@ pub fn sample_region(
     let mut patches: Vec<PatchId> = pixels.iter().map(|(_, p)| *p).collect();
     patches.sort_unstable();
     patches.dedup();
-    let carved = carve_patches(&patches, planet, network, config);
+    let total = patches.len();
+    let carved = carve_patches(&patches, planet, network, config, &|| carved(total));
     let n = config.rendering.vertices;
     let sample = |layer: fn(&CarvedPatch) -> &[f32]| -> Vec<f32> {
         pixels

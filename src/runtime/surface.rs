@@ -77,12 +77,14 @@ pub fn carve_patch(
 }
 
 /// The surfaces of `patches` (all of one level), in parallel, each patch's base heights refined on the CPU as the
-/// renderer refines them on the GPU ([`Planet::patch_heights`]).
+/// renderer refines them on the GPU ([`Planet::patch_heights`]); `carved` is called as each one is done (from any
+/// thread: progress).
 pub fn carve_patches(
     patches: &[PatchId],
     planet: &Planet,
     network: &RiverNetwork,
     config: &Config,
+    carved: &(dyn Fn() + Sync),
 ) -> HashMap<PatchId, CarvedPatch> {
     let n = config.rendering.vertices;
     let params = KernelParams::from_config(config);
@@ -91,7 +93,9 @@ pub fn carve_patches(
         .map(|&patch| {
             let heights = planet.patch_heights(patch);
             let base = |i: u32, j: u32| heights.get(i as i64, j as i64);
-            (patch, carve_patch(patch, base, planet, network, n, &params))
+            let surface = carve_patch(patch, base, planet, network, n, &params);
+            carved();
+            (patch, surface)
         })
         .collect()
 }
