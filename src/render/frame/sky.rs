@@ -58,13 +58,21 @@ impl Sky {
             },
             layers: 1,
             format: Format::R32G32B32A32_SFLOAT,
-            uses: &[Access::GraphicsSampled, Access::TransferWrite],
+            uses: &[
+                Access::GraphicsSampled,
+                Access::ComputeSampled,
+                Access::TransferWrite,
+            ],
             array: true,
         })?;
         ctx.run_and_wait("upload atmosphere transmittance", |rec| {
             rec.overwrite_images(&[&image], &[Access::TransferWrite]);
             rec.upload_image_layer(&image, 0, bytemuck::cast_slice(&table.texels))?;
-            rec.use_images(&[&image], &[Access::GraphicsSampled]);
+            // Sampled by the terrain's shaders and by the sky dome's compute pass.
+            rec.use_images(
+                &[&image],
+                &[Access::GraphicsSampled, Access::ComputeSampled],
+            );
             Ok(())
         })?;
         let indices = dome_mesh(RINGS, SEGMENTS);

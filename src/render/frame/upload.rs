@@ -132,9 +132,11 @@ impl Renderer<'_> {
             self.frames.profiler().end(rec, scope);
             bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
+        // Read by the terrain's shaders, and by the vertex cache's compute pass before them (draw.rs): without the
+        // compute stage here, a GPU could compute a new patch's vertices before its heights were written.
         rec.memory_barrier(
             &[Access::ComputeWrite, Access::TransferWrite],
-            &[Access::GraphicsSampled],
+            &[Access::GraphicsSampled, Access::ComputeSampled],
         );
 
         let mut rivers: Vec<(Image, Slot)> = Vec::new();
@@ -174,7 +176,10 @@ impl Renderer<'_> {
                 .kernel
                 .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
             self.frames.profiler().end(rec, scope);
-            rec.use_images(&textures, &[Access::GraphicsSampled]);
+            rec.use_images(
+                &textures,
+                &[Access::GraphicsSampled, Access::ComputeSampled],
+            );
         }
         let river_count = rivers.len();
         let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();
