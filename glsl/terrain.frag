@@ -115,10 +115,16 @@ vec4 noiseGradient(vec3 x) {
     return vec4(gradient, value);
 }
 
-// The ripples' height field, two octaves, and its gradient (xyz) with its value (w).
-vec4 ripple(vec3 q) {
-    vec4 fine = noiseGradient(q * 2.3 + 11.0);
-    return noiseGradient(q) + 0.5 * vec4(fine.xyz * 2.3, fine.w);
+// The ripples' height field, two octaves, and its gradient (xyz) with its value (w). The fine octave, 2.3 times
+// smaller, takes `fine` of its weight (it fades out sooner than the ripples as a whole, rippleSpace), and is not
+// evaluated where it has faded.
+vec4 ripple(vec3 q, float fine) {
+    vec4 r = noiseGradient(q);
+    if (fine > 0.0) {
+        vec4 small = noiseGradient(q * 2.3 + 11.0);
+        r += 0.5 * fine * vec4(small.xyz * 2.3, small.w);
+    }
+    return r;
 }
 
 // The two phases' positions and the first one's weight.
@@ -153,9 +159,9 @@ const float FOAM_COVER = 0.15;
 
 // Beyond the thesis: the lit colour and opacity of water, flowing unless still (the thesis's, Section 8.4): the
 // rippled normal, foam at the bank (rivers) or the shore (the sea) broken up by the moving ripples, the reflected
-// sky, the sun's glint. `q`: the fragment in ripple sizes, `visible`: how much the ripples show (both from
-// rippleSpace, in uniform control flow); `depth`: the water above the terrain.
-vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 view, vec3 sun) {
+// sky, the sun's glint. `q`: the fragment in ripple sizes, `visible`: how much the ripples and their fine octave
+// show (both from rippleSpace, in uniform control flow); `depth`: the water above the terrain.
+vec4 waterSurface(bool river, float depth, vec3 q, vec2 visible, vec3 up, vec3 view, vec3 sun) {
     vec3 wind = cross(up, vec3(0.0, 1.0, 0.0));
     vec3 velocity = river ? fFlow * 0.8 : wind * 0.15;
     vec3 q0, q1;
@@ -168,11 +174,11 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
     // its average cover where they are smaller than a pixel (else the banks sparkle in the distance).
     vec3 surface = up;
     float cover = FOAM_COVER;
-    if (visible > 0.0) {
-        vec4 r0 = ripple(q0);
-        vec4 r1 = ripple(q1);
-        surface = flowingNormal(up, r0, r1, w0, 0.35 * visible);
-        cover = mix(FOAM_COVER, smoothBand(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible);
+    if (visible.x > 0.0) {
+        vec4 r0 = ripple(q0, visible.y);
+        vec4 r1 = ripple(q1, visible.y);
+        surface = flowingNormal(up, r0, r1, w0, 0.35 * visible.x);
+        cover = mix(FOAM_COVER, smoothBand(0.8, 1.2, w0 * r0.w + (1.0 - w0) * r1.w), visible.x);
     }
     float foam = edge * cover;
     vec3 colour = mix(WATER_SHALLOW, WATER_DEEP, clamp(depth / (4.0 * frame.extra.z), 0.0, 1.0));
@@ -190,13 +196,17 @@ vec4 waterSurface(bool river, float depth, vec3 q, float visible, vec3 up, vec3 
 }
 
 // The fragment in ripple sizes (rivers: the river's half width; the sea: a unit of colour band, extra.z) and how
-// much ripples show: they fade where one is smaller than a pixel, and still water has none. Takes derivatives.
+// much ripples show (x) and their fine octave (y): each fades where its cells come near a pixel's size (the fine
+// octave's, 2.3 times smaller, alone left white strokes across rivers seen from above), and still water has none.
+// Takes derivatives.
 // From fDetail, small near the camera: the direction times the radius in f32 put an Earth river's ripples 0.4 m
 // apart, a tenth of a ripple on a narrow one, and broke them into streaks.
-vec3 rippleSpace(bool river, out float visible) {
+vec3 rippleSpace(bool river, out vec2 visible) {
     float size = river ? max(fRiver.w, 0.02) : frame.extra.z;
     vec3 q = fDetail / size;
-    visible = stillWater() ? 0.0 : 1.0 - smoothBand(0.4, 1.2, length(fwidth(q)));
+    float footprint = length(fwidth(q));
+    visible = stillWater() ? vec2(0.0)
+                           : vec2(1.0) - vec2(smoothBand(0.4, 1.2, footprint), smoothBand(0.4, 1.2, 2.3 * footprint));
     return q;
 }
 
@@ -231,7 +241,7 @@ void main() {
     vec3 view = normalize(-fPosition);
     if (WATER_PASS == 1) {
         bool river = fRiverWater > 0.5;
-        float visible;
+        vec2 visible;
         vec3 q = rippleSpace(river, visible);
         // River water covers the basin only: a triangle reaching past the banks is cut at the river's width.
         if (river && abs(fRiver.z) > fRiver.w) discard;
@@ -239,9 +249,9 @@ void main() {
         outColor = vec4(atmosphereOn() ? throughAir(water.rgb) : water.rgb, water.a);
         return;
     }
-    float visible;
+    vec2 visible;
     vec3 q = rippleSpace(true, visible);
-    float seaVisible;
+    vec2 seaVisible;
     vec3 seaQ = rippleSpace(false, seaVisible);
     // Derivatives in uniform control flow, before any branch.
     vec2 dz = vec2(dFdx(fRiver.z), dFdy(fRiver.z));

@@ -5,22 +5,28 @@ mod common;
 
 use std::{path::PathBuf, process::Command};
 
-/// The built example `name` (`cargo test` builds every example; built here when this test runs alone).
+/// The built example `name`: `cargo test` builds every example, `cargo test --test examples` alone does not (and
+/// cargo cannot be run from here: the running cargo holds the build directory), so one missing or older than the
+/// library it links is refused with what to run.
 fn example(name: &str) -> PathBuf {
     let exe = std::env::current_exe().unwrap();
-    let profile = exe.parent().unwrap().parent().unwrap();
-    let path = profile.join("examples").join(name);
-    if !path.exists() {
-        let mut build = Command::new(env!("CARGO"));
-        build.args(["build", "--examples"]);
-        if profile.ends_with("release") {
-            build.arg("--release");
-        }
-        assert!(
-            build.status().unwrap().success(),
-            "cargo build --examples failed"
-        );
-    }
+    let deps = exe.parent().unwrap();
+    let path = deps.parent().unwrap().join("examples").join(name);
+    let modified = |p: &std::path::Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let library = std::fs::read_dir(deps)
+        .unwrap()
+        .flatten()
+        .filter(|e| {
+            let file = e.file_name().to_string_lossy().to_string();
+            file.starts_with("libriverplanet-") && file.ends_with(".rlib")
+        })
+        .filter_map(|e| modified(&e.path()))
+        .max();
+    let built = modified(&path);
+    assert!(
+        built.is_some() && built >= library,
+        "example {name} is not built or older than the library: run `cargo build --release --examples` first"
+    );
     path
 }
 
