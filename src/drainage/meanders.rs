@@ -44,7 +44,7 @@ pub struct MeanderScale {
     pub cell: f64,
     /// The planet's radius (world units per radian).
     pub radius: f64,
-    /// Relief over radius: the slope that [`HALF_SWING_SLOPE`] is a share of.
+    /// Relief over radius: the slope that `HALF_SWING_SLOPE` is a share of.
     pub relief_slope: f64,
 }
 
@@ -167,7 +167,7 @@ pub fn crossing_reaches(reaches: &[ReachPath]) -> std::collections::BTreeSet<usi
 }
 
 /// The swing of a course whose valley falls by `slope` (drop over run, as a share of the planet's relief over its
-/// radius): [`FLAT_SWING`] on a flat floor, half of it at [`HALF_SWING_SLOPE`] (Schumm 1963).
+/// radius): `FLAT_SWING` on a flat floor, half of it at `HALF_SWING_SLOPE` (Schumm 1963).
 pub fn swing_on(slope: f64) -> f64 {
     FLAT_SWING / (1.0 + (slope / HALF_SWING_SLOPE).powi(2))
 }

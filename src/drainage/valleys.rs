@@ -54,7 +54,7 @@ fn river_beds(
     (river_nodes, bed)
 }
 
-/// The heights with every river node at its bed ([`river_beds`]) and nothing else changed: the eroded relief's
+/// The heights with every river node at its bed (`river_beds`) and nothing else changed: the eroded relief's
 /// valleys are the erosion's own, only the sills that filled depressions leave along a river are cut.
 pub fn cut_beds(
     grid: &SphereGrid,
@@ -71,7 +71,7 @@ pub fn cut_beds(
     out
 }
 
-/// The heights with valleys carved. A river node sits at its bed ([`river_beds`]). A node within a valley's
+/// The heights with valleys carved. A river node sits at its bed (`river_beds`). A node within a valley's
 /// half-width `w` at distance `d` of its nearest river node keeps its height above that bed scaled by
 /// `(d / w)^2`, never raised. Sea and lake nodes keep their heights.
 pub fn carve(

@@ -8,7 +8,7 @@ use ash::{ext, vk};
 
 use super::{debug::VALIDATION_LAYER, GpuError, VkResultExt};
 
-/// How to create a [`Context`].
+/// How to create a [`super::Context`].
 #[derive(Clone, Debug, Default)]
 pub struct ContextOptions {
     /// Enable the Khronos validation layer and collect its errors.

@@ -39,7 +39,7 @@ fn specialization_entries(data: &[u8]) -> Vec<vk::SpecializationMapEntry> {
 }
 
 /// A descriptor set layout of `count` storage buffers at bindings 0..count, for per-dispatch inputs (samples,
-/// range table). Sets are allocated per recording with [`Recorder::buffer_set`].
+/// range table). Sets are allocated per recording with [`super::Recorder::buffer_set`].
 pub struct BufferSetLayout {
     pub layout: vk::DescriptorSetLayout,
     pub count: u32,

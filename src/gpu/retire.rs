@@ -1,5 +1,5 @@
 //! Deferred destruction and reuse. A dropped buffer or image (or pipeline, layout, sampler or pool, through
-//! [`RetireOnDrop`]) is retired: freed only after the GPU has finished every submission made before it was dropped,
+//! `RetireOnDrop`) is retired: freed only after the GPU has finished every submission made before it was dropped,
 //! and the submission of any recording open when it was dropped (Granite's per-frame lists, keyed here by
 //! timeline-semaphore value). Dropping is retiring, so none can leak by being forgotten, and no owner calls
 //! `destroy`. A retired buffer or image whose GPU work is done is kept (the latest, up to [`RECYCLED_BYTES`]) for the next

@@ -166,7 +166,7 @@ impl<'a> Recorder<'a> {
         self.owned.push(buffer);
     }
 
-    /// A descriptor set of `layout` pointing at `buffers` (binding i = buffers[i], whole range), valid for this
+    /// A descriptor set of `layout` pointing at `buffers` (binding i = `buffers[i]`, whole range), valid for this
     /// recording only.
     pub fn buffer_set(
         &mut self,

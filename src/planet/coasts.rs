@@ -3,7 +3,7 @@
 //! islands at every scale instead of the Voronoi cells' straight edges, while continents' cores stay whole.
 //!
 //! The noise sums value-noise octaves from a few hundred kilometres on Earth down to two base cells, each twice
-//! as fine and [`PERSISTENCE`] as strong (a Hurst exponent H of 0.6): the level set of such a field has a
+//! as fine and `PERSISTENCE` as strong (a Hurst exponent H of 0.6): the level set of such a field has a
 //! box-counting dimension near 2 - H (Mandelbrot 1975; Voss 1985), and real coasts measure 1.15-1.4.
 
 use rayon::prelude::*;

@@ -34,7 +34,7 @@ const JOIN_CELLS: f64 = 0.75;
 /// Points of a reach per Hermite segment (lattice nodes, or points of a meandering course).
 const NODES_PER_SEGMENT: usize = 2;
 
-/// The river systems of `drainage`: each mouth's tree, split where it grows beyond [`SYSTEM_ANGLE`]; the system
+/// The river systems of `drainage`: each mouth's tree, split where it grows beyond `SYSTEM_ANGLE`; the system
 /// of the largest river first.
 pub fn systems(
     drainage: &Drainage,

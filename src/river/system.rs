@@ -126,7 +126,7 @@ pub struct SubdivisionParams {
     pub min_width: f32,
     /// Beyond the thesis: with the drainage model on eroded relief, the planet's relief over its radius, against
     /// which a piece's slope sets the swing of the meanders it gets when it is first short enough to hold them
-    /// ([`meander_knots`]); `None` (other models, or `fine-meanders` off): the thesis's random displacement only.
+    /// (`meander_knots`); `None` (other models, or `fine-meanders` off): the thesis's random displacement only.
     pub meander_relief_slope: Option<f64>,
 }
 
@@ -163,7 +163,7 @@ impl SubdivisionParams {
 /// from the piece's key only.
 ///
 /// Beyond the thesis (drainage model on eroded relief, docs/rivers.md "Meanders below the base lattice"): the
-/// first piece of a river short enough to hold its meanders ([`meander_knots`]) is split along a sine-generated
+/// first piece of a river short enough to hold its meanders (`meander_knots`) is split along a sine-generated
 /// course instead, so rivers narrower than the base lattice resolves meander at the levels that draw them.
 pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>, Option<Segment>) {
     let (knots, at) = match meander_knots(segment, params) {

@@ -108,8 +108,8 @@ pub fn cached(ctx: &Context, grid_size: u32, path: Option<&Path>) -> Result<Tune
     Ok(t)
 }
 
-/// Times the simple kernel and every valid tiled shape on a synthetic workload of [`PATCHES`] patches crossed by
-/// [`RIVERS_PER_PATCH`] x 1-3 random rivers (Section 6.4's sampling), the median of [`REPETITIONS`] runs each.
+/// Times the simple kernel and every valid tiled shape on a synthetic workload of `PATCHES` patches crossed by
+/// `RIVERS_PER_PATCH` x 1-3 random rivers (Section 6.4's sampling), the median of `REPETITIONS` runs each.
 pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
     let params = KernelParams {
         influence_distance: 20.0,
