@@ -130,15 +130,15 @@ fn compute_dispatch_reads_back_and_is_timed() {
     let push: [u32; 3] = [0.5f32.to_bits(), 3.0f32.to_bits(), COUNT];
     ctx.run_and_wait("fill", |rec| {
         let set = rec.buffer_set(&sets, &[&out])?;
-        let scope = profiler.begin(rec, "fill kernel")?;
-        rec.use_buffer(&out, &[Access::ComputeWrite]);
-        rec.dispatch(
-            &pipeline,
-            &[set],
-            bytemuck::cast_slice(&push),
-            [COUNT.div_ceil(64), 1, 1],
-        );
-        profiler.end(rec, scope);
+        profiler.scope(rec, "fill kernel", |rec| {
+            rec.use_buffer(&out, &[Access::ComputeWrite]);
+            rec.dispatch(
+                &pipeline,
+                &[set],
+                bytemuck::cast_slice(&push),
+                [COUNT.div_ceil(64), 1, 1],
+            );
+        })?;
         rec.copy_buffer(&out, &readback, size);
         Ok(())
     })

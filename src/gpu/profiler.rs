@@ -62,8 +62,22 @@ impl Profiler {
         self.names.clear();
     }
 
+    /// Records `body` as the timed scope `name`, inside a debug label of that name: what it records is one pass
+    /// of the frame, timed and named without a begin and an end to pair by hand.
+    pub fn scope<T>(
+        &mut self,
+        rec: &mut Recorder,
+        name: &str,
+        body: impl FnOnce(&mut Recorder) -> T,
+    ) -> Result<T, GpuError> {
+        let scope = self.begin(rec, name)?;
+        let out = body(rec);
+        self.end(rec, scope);
+        Ok(out)
+    }
+
     /// Writes the begin timestamp of scope `name` and opens a debug label.
-    pub fn begin(&mut self, rec: &mut Recorder, name: &str) -> Result<Scope, GpuError> {
+    fn begin(&mut self, rec: &mut Recorder, name: &str) -> Result<Scope, GpuError> {
         let index = self.names.len() as u32;
         if index >= self.capacity {
             return Err(GpuError::Invalid(format!(
@@ -87,7 +101,7 @@ impl Profiler {
     }
 
     /// Writes the end timestamp of `scope` and closes its label.
-    pub fn end(&mut self, rec: &mut Recorder, scope: Scope) {
+    fn end(&mut self, rec: &mut Recorder, scope: Scope) {
         let ctx = rec.ctx();
         // SAFETY: as in begin.
         unsafe {

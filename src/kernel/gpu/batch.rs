@@ -161,9 +161,9 @@ pub fn run_batch_into(
             jobs,
             parents,
         };
-        let scope = profiler.begin(rec, "kernel")?;
-        let bytes = kernel.record(rec, bindless, variant, &batch, params)?;
-        profiler.end(rec, scope);
+        let bytes = profiler.scope(rec, "kernel", |rec| {
+            kernel.record(rec, bindless, variant, &batch, params)
+        })??;
         rec.use_images(&image_refs, &[Access::TransferRead]);
         for (k, image) in images.iter().enumerate() {
             rec.copy_image_to_buffer(image, readback, k as u64 * texel_bytes);

@@ -332,14 +332,14 @@ impl Renderer<'_> {
         let push = self.frame_push(camera);
         let sets = [self.bindless.set, instance_set];
         let push = bytemuck::bytes_of(&push);
-        let scope = self.frames.profiler().begin(rec, "vertices")?;
-        self.vertex_cache
-            .record(rec, (&sets, push), &vertex_cache, cached, n, water_pass);
-        self.frames.profiler().end(rec, scope);
+        let cache = &self.vertex_cache;
+        self.frames.profiler().scope(rec, "vertices", |rec| {
+            cache.record(rec, (&sets, push), &vertex_cache, cached, n, water_pass)
+        })?;
         if let (Some(sky), Some(vertices)) = (&self.sky, &dome_vertices) {
-            let scope = self.frames.profiler().begin(rec, "sky dome")?;
-            sky.record_dome(rec, (&sets, push), vertices);
-            self.frames.profiler().end(rec, scope);
+            self.frames.profiler().scope(rec, "sky dome", |rec| {
+                sky.record_dome(rec, (&sets, push), vertices)
+            })?;
         }
         rec.free_after_completion(vertex_cache);
         // The target is cleared, so its contents are discarded; the wait for the earlier writes to it (the frame
@@ -347,51 +347,51 @@ impl Renderer<'_> {
         rec.use_attachment(target, Attachment::Color, &[Access::ColorAttachment], true);
         rec.use_attachment(target, Attachment::Depth, &[Access::DepthAttachment], true);
         rec.begin_rendering(target, true);
-        let scope = self.frames.profiler().begin(rec, "terrain")?;
-        for (indices, instances, cull) in terrain_draws {
-            if instances.is_empty() {
-                continue;
+        self.frames.profiler().scope(rec, "terrain", |rec| {
+            for (indices, instances, cull) in terrain_draws {
+                if instances.is_empty() {
+                    continue;
+                }
+                let terrain = match (self.wireframe_on, cull) {
+                    (true, _) => &self.wireframe,
+                    (false, true) => &self.terrain,
+                    (false, false) => &self.terrain_unculled,
+                };
+                stats.terrain_triangles += (indices.len() / 3 * instances.len()) as u64;
+                rec.draw_indexed(terrain, &sets, push, &self.indices, indices, instances);
             }
-            let terrain = match (self.wireframe_on, cull) {
-                (true, _) => &self.wireframe,
-                (false, true) => &self.terrain,
-                (false, false) => &self.terrain_unculled,
-            };
-            stats.terrain_triangles += (indices.len() / 3 * instances.len()) as u64;
-            rec.draw_indexed(terrain, &sets, push, &self.indices, indices, instances);
-        }
-        self.frames.profiler().end(rec, scope);
-        let scope = self.frames.profiler().begin(rec, "water")?;
-        if let (Some(indices), Some(draws)) = (&water_indices, &water_draws) {
-            rec.draw_indexed_indirect(
-                &self.cached_water,
-                (&sets, push),
-                indices,
-                draws,
-                4 * cached as u32,
-            );
-            for mesh in &self.quadrants {
-                rec.draw_indexed(
-                    &self.water,
-                    &sets,
-                    push,
-                    &self.indices,
-                    mesh.grid.clone(),
-                    water_instances.clone(),
+        })?;
+        self.frames.profiler().scope(rec, "water", |rec| {
+            if let (Some(indices), Some(draws)) = (&water_indices, &water_draws) {
+                rec.draw_indexed_indirect(
+                    &self.cached_water,
+                    (&sets, push),
+                    indices,
+                    draws,
+                    4 * cached as u32,
                 );
+                for mesh in &self.quadrants {
+                    rec.draw_indexed(
+                        &self.water,
+                        &sets,
+                        push,
+                        &self.indices,
+                        mesh.grid.clone(),
+                        water_instances.clone(),
+                    );
+                }
             }
-        }
-        for buffer in water_draws.into_iter().chain(water_indices) {
-            rec.free_after_completion(buffer);
-        }
-        if let Some(vertices) = dome_vertices {
-            rec.free_after_completion(vertices);
-        }
-        self.frames.profiler().end(rec, scope);
+            for buffer in water_draws.into_iter().chain(water_indices) {
+                rec.free_after_completion(buffer);
+            }
+            if let Some(vertices) = dome_vertices {
+                rec.free_after_completion(vertices);
+            }
+        })?;
         if let (true, Some(sky)) = (draw_sky, &self.sky) {
-            let scope = self.frames.profiler().begin(rec, "sky")?;
-            sky.record(rec, &sets, push);
-            self.frames.profiler().end(rec, scope);
+            self.frames
+                .profiler()
+                .scope(rec, "sky", |rec| sky.record(rec, &sets, push))?;
         }
         if let Some(draw) = overlay {
             draw(rec, target.extent());

@@ -125,11 +125,10 @@ impl Renderer<'_> {
         let mut bytes = 0;
         let mut ranges = None;
         if !jobs.is_empty() {
-            let scope = self.frames.profiler().begin(rec, "heights")?;
-            ranges = self
-                .refiner
-                .record(rec, &self.bindless, self.planet, &jobs)?;
-            self.frames.profiler().end(rec, scope);
+            let (refiner, bindless, planet) = (&self.refiner, &self.bindless, self.planet);
+            ranges = self.frames.profiler().scope(rec, "heights", |rec| {
+                refiner.record(rec, bindless, planet, &jobs)
+            })??;
             bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
         // Read by the terrain's shaders, and by the vertex cache's compute pass before them (draw.rs): without the
@@ -171,11 +170,11 @@ impl Renderer<'_> {
                 jobs: &patch_jobs,
                 parents: &parents,
             };
-            let scope = self.frames.profiler().begin(rec, "kernel")?;
-            bytes += self
-                .kernel
-                .record(rec, &self.bindless, self.variant, &batch, &self.params)?;
-            self.frames.profiler().end(rec, scope);
+            let (kernel, bindless, variant, params) =
+                (&self.kernel, &self.bindless, self.variant, &self.params);
+            bytes += self.frames.profiler().scope(rec, "kernel", |rec| {
+                kernel.record(rec, bindless, variant, &batch, params)
+            })??;
             rec.use_images(
                 &textures,
                 &[Access::GraphicsSampled, Access::ComputeSampled],
