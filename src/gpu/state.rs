@@ -1,4 +1,4 @@
-//! What each image was last recorded for, so that a caller names only its next use and the recorder emits the
+//! What each image and buffer was last recorded for, so that a caller names only its next use and the recorder emits the
 //! barrier from the last one (the per-resource state of kajiya's render graph and wgpu-core's trackers). Commands
 //! run on one queue in the order they are submitted, and each recording is submitted in the order it is recorded,
 //! so the last use recorded is the last use run before the next one.
@@ -7,13 +7,13 @@ use std::sync::{Arc, Mutex};
 
 use super::access::Access;
 
-/// The uses an image was last recorded for, shared by everything that records its barriers (its [`super::Image`],
-/// a [`super::pipeline::RenderTarget`] drawn into it).
+/// The uses an image or a buffer was last recorded for, shared by everything that records its barriers (its
+/// [`super::Image`] and a [`super::pipeline::RenderTarget`] drawn into it; its [`super::Buffer`]).
 #[derive(Debug)]
 pub(crate) struct UseState(Mutex<Vec<Access>>);
 
 impl UseState {
-    /// An image with no use yet: its contents undefined.
+    /// A resource with no use yet: its contents undefined, nothing to wait for.
     pub(crate) fn fresh() -> Arc<Self> {
         Arc::new(Self(Mutex::new(vec![Access::Nothing])))
     }
