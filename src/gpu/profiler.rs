@@ -25,7 +25,7 @@ pub struct Profiler {
     _retire: RetireOnDrop,
 }
 
-/// An open scope; close it with [`Profiler::end`].
+/// An open scope ([`Profiler::scope`] closes it).
 #[must_use]
 pub struct Scope(u32);
 
