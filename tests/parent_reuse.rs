@@ -183,10 +183,7 @@ fn above_the_final_detail_the_parent_draws_other_rivers_than_its_children() {
 /// to the camera, by patch) and how many patches took river data from their parent on the way.
 fn ground_vertices(parent_reuse: bool) -> Option<(VertexCapture, usize)> {
     let ctx = common::gpu()?;
-    let mut config =
-        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml")).unwrap();
-    config.rendering.generation_budget_ms = 1e6;
-    let world = World::build(&config, config.resolve_seed()).unwrap();
+    let world = common::earth_streaming_at_once();
     let (eye, look_at) = presets::camera(Preset::Ground, &world).unwrap();
     let camera = Camera::look_at(eye, look_at, 60.0, 16.0 / 9.0, 0.1);
     let offscreen = Offscreen::new(ctx, 64, 36).unwrap();

@@ -5,11 +5,10 @@
 
 mod common;
 
-use std::{collections::HashMap, path::Path};
+use std::collections::HashMap;
 
 use glam::DVec3;
 use riverplanet::{
-    config::Config,
     planet::cube::PatchId,
     render::{
         presets::{self, Preset},
@@ -17,7 +16,6 @@ use riverplanet::{
         Renderer, VertexCapture,
     },
     runtime::camera::Camera,
-    world::World,
 };
 
 /// Vertices this close to the camera are checked (metres).
@@ -37,11 +35,9 @@ fn near_vertices(capture: &VertexCapture) -> HashMap<(PatchId, u32, u32), (DVec3
 #[test]
 fn two_metres_above_an_earth_sized_river_vertices_are_exact_to_a_millimetre_and_do_not_jitter() {
     let Some(ctx) = common::gpu() else { return };
-    let mut config =
-        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml")).unwrap();
-    // Stream everything in as fast as the device goes: this test is about positions, not budgets.
-    config.rendering.generation_budget_ms = 1e6;
-    let world = World::build(&config, config.resolve_seed()).unwrap();
+    // Everything streamed in as fast as the device goes: this test is about positions, not budgets.
+    let world = common::earth_streaming_at_once();
+    let config = &world.config;
     let radius = world.planet.radius;
     let n = config.rendering.vertices;
     let (eye, look_at) = presets::camera(Preset::Ground, &world).unwrap();
@@ -163,10 +159,7 @@ fn row_to_row_change(image: &image::RgbaImage) -> f64 {
 #[test]
 fn ripples_on_an_earth_river_show_no_streaks() {
     let Some(ctx) = common::gpu() else { return };
-    let mut config =
-        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml")).unwrap();
-    config.rendering.generation_budget_ms = 1e6;
-    let world = World::build(&config, config.resolve_seed()).unwrap();
+    let world = common::earth_streaming_at_once();
     let (eye, look_at) = presets::camera(Preset::Ground, &world).unwrap();
     let camera = Camera::look_at(eye, look_at, 60.0, 16.0 / 9.0, 0.1);
     let offscreen = Offscreen::new(ctx, 640, 360).unwrap();

@@ -111,3 +111,13 @@ pub fn render_frame(renderer: &mut Renderer, camera: &Camera, target: &Offscreen
         )
         .unwrap()
 }
+
+/// config/earth.xml's world, its patches streamed in as fast as the device goes (no generation budget): for tests
+/// of what the ground view draws, not of budgets.
+pub fn earth_streaming_at_once() -> World {
+    let mut config =
+        Config::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml"))
+            .unwrap();
+    config.rendering.generation_budget_ms = 1e6;
+    World::build(&config, config.resolve_seed()).unwrap()
+}
