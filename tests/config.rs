@@ -289,7 +289,7 @@ fn the_river_model_is_named_or_refused() {
 fn the_relief_model_is_named_and_fits_its_river_model_or_is_refused() {
     let message = error_of(&with("planet-attributes", "relief-model", "rain"));
     assert!(
-        message.contains("relief-model") && message.contains("thesis, carved, eroded"),
+        message.contains("relief-model") && message.contains("thesis, carved, eroded, file"),
         "{message}"
     );
     // The thesis's rivers start at the thesis's mountains; the drainage model drains the other reliefs.
@@ -299,7 +299,7 @@ fn the_relief_model_is_named_and_fits_its_river_model_or_is_refused() {
         "<planet-attributes><relief-model>thesis</relief-model>",
         1,
     ));
-    assert!(message.contains("eroded or carved"), "{message}");
+    assert!(message.contains("eroded, carved or file"), "{message}");
     let message = error_of(&with("planet-attributes", "relief-model", "eroded"));
     assert!(message.contains("must be thesis"), "{message}");
     assert_eq!(

@@ -70,6 +70,13 @@ pub struct PlanetConfig {
     /// Eroded relief (beyond the thesis): the lowlands' uplift grows inland by this share of itself per radian
     /// from the sea, so continental interiors stand higher than their coastal plains (0: one lowland uplift).
     pub interior_rise: f32,
+    /// Relief `file` (beyond the thesis): the whole planet's heights as an equirectangular raster (TIFF, OpenEXR or
+    /// 16-bit PNG; docs/planet.md, "Heights from a file"); in a file, relative to the file's folder.
+    pub terrain_file: String,
+    /// A 16-bit PNG terrain's heights: `terrain-height-offset + terrain-height-scale x value`, where no JSON
+    /// beside the file gives them.
+    pub terrain_height_scale: f32,
+    pub terrain_height_offset: f32,
 }
 
 /// How the land gets its relief.
@@ -84,16 +91,25 @@ pub enum ReliefModel {
     /// Beyond the thesis, the default: tectonic uplift balanced by stream-power erosion (docs/planet.md, "Relief
     /// from uplift and erosion"); the rivers are the ones the erosion made.
     Eroded,
+    /// Beyond the thesis: the heights of `terrain-file`, a whole planet's raster (docs/planet.md, "Heights from a
+    /// file"); its valleys are the data's, so rivers follow them as on eroded relief.
+    File,
 }
 
 impl ReliefModel {
+    /// Whether the relief has its valleys before any river is drawn (eroded or measured), so rivers keep to them:
+    /// beds cut into the valley floors rather than valleys carved around the rivers, and meanders on gentle slopes.
+    pub fn has_valleys(self) -> bool {
+        matches!(self, ReliefModel::Eroded | ReliefModel::File)
+    }
+
     /// The default `source-area` of the drainage model on this relief (world units squared): eroded relief drains
     /// in more branched networks, whose first-order streams start at 300 square units (about two base cells;
     /// docs/geomorphology.md measures Horton's ratio and Strahler's order with it); the carved relief keeps the
     /// 700 it was tuned with. Irrelevant to the thesis's model.
     pub fn source_area(self) -> f32 {
         match self {
-            ReliefModel::Eroded => 300.0,
+            ReliefModel::Eroded | ReliefModel::File => 300.0,
             ReliefModel::Carved | ReliefModel::Thesis => 700.0,
         }
     }
@@ -104,6 +120,7 @@ impl crate::named::Named for ReliefModel {
         ("thesis", Self::Thesis),
         ("carved", Self::Carved),
         ("eroded", Self::Eroded),
+        ("file", Self::File),
     ];
 }
 
@@ -263,6 +280,9 @@ impl Config {
                 base_resolution: 129,
                 relief_model: ReliefModel::Thesis,
                 interior_rise: 0.0,
+                terrain_file: String::new(),
+                terrain_height_scale: 1.0,
+                terrain_height_offset: 0.0,
             },
             river: RiverConfig {
                 model: RiverModel::Thesis,

@@ -129,6 +129,13 @@ const PLANET: &[Param<PlanetConfig>] = &[
     Param::Number("interior-rise", Range::Closed(0.0, 20.0), |c| {
         &mut c.interior_rise
     }),
+    Param::Path("terrain-file", |c| &mut c.terrain_file),
+    Param::Number("terrain-height-scale", Range::Positive, |c| {
+        &mut c.terrain_height_scale
+    }),
+    Param::Number("terrain-height-offset", Range::Any, |c| {
+        &mut c.terrain_height_offset
+    }),
 ];
 
 /// `<river-attributes>`.

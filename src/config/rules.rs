@@ -88,10 +88,29 @@ impl Config {
                 match river.model {
                     RiverModel::Thesis => "must be thesis with river-model thesis".to_string(),
                     RiverModel::Drainage => {
-                        "must be eroded or carved with river-model drainage".to_string()
+                        "must be eroded, carved or file with river-model drainage".to_string()
                     }
                 },
             ));
+        }
+        // Heights from a file: the file and the relief model name each other.
+        match (planet.relief_model == ReliefModel::File, planet.terrain_file.is_empty()) {
+            (true, true) => {
+                return Err(error(
+                    "terrain-file",
+                    String::new(),
+                    "must name a whole planet's height raster (.tif, .exr or .png) with relief-model file"
+                        .to_string(),
+                ))
+            }
+            (false, false) => {
+                return Err(error(
+                    "relief-model",
+                    planet.relief_model.name().to_string(),
+                    format!("must be file with terrain-file ({})", planet.terrain_file),
+                ))
+            }
+            _ => {}
         }
         let widest = river.starting_width * river.ending_factor.max(1.0);
         if river.influence_distance <= widest * 0.5 {

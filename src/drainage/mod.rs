@@ -16,7 +16,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::{
-    config::{PlanetConfig, ReliefModel, RiverConfig},
+    config::{PlanetConfig, RiverConfig},
     planet::heights::FaceLattice,
 };
 use grid::SphereGrid;
@@ -95,10 +95,11 @@ pub fn drain_paths(
             lake_depth: river.lake_depth as f64,
         },
     );
-    // Eroded relief has its valleys already: the rivers are the ones the erosion cut.
-    let carved = match planet.relief_model {
-        ReliefModel::Eroded => valleys::cut_beds(grid, &routing, &network, &heights, sea_level),
-        _ => valleys::carve(grid, &routing, &network, &heights, sea_level),
+    // Eroded or measured relief has its valleys already: the rivers are the ones the erosion (or the land) cut.
+    let carved = if planet.relief_model.has_valleys() {
+        valleys::cut_beds(grid, &routing, &network, &heights, sea_level)
+    } else {
+        valleys::carve(grid, &routing, &network, &heights, sea_level)
     };
     grid.write(&carved, lattice);
     let r2 = radius * radius;
@@ -155,18 +156,17 @@ pub fn meander_reaches(
     river: &RiverConfig,
     largest_area: f64,
 ) -> Vec<ReachPath> {
-    match planet.relief_model {
-        ReliefModel::Eroded => {
-            let radius = planet.radius as f64;
-            let scale = meanders::MeanderScale {
-                cell: std::f64::consts::FRAC_PI_2 / cells as f64,
-                radius,
-                relief_slope: (planet.max_mountain_height - planet.sea_level_height) as f64
-                    / radius,
-            };
-            meanders::meander_all(reaches, &scale, |a| width(river, largest_area, a) as f64)
-        }
-        _ => reaches.to_vec(),
+    if !planet.relief_model.has_valleys() {
+        return reaches.to_vec();
+    }
+    {
+        let radius = planet.radius as f64;
+        let scale = meanders::MeanderScale {
+            cell: std::f64::consts::FRAC_PI_2 / cells as f64,
+            radius,
+            relief_slope: (planet.max_mountain_height - planet.sea_level_height) as f64 / radius,
+        };
+        meanders::meander_all(reaches, &scale, |a| width(river, largest_area, a) as f64)
     }
 }
 

@@ -14,6 +14,7 @@ pub mod lakes;
 pub mod mountains;
 pub mod noise;
 pub mod relief;
+pub mod terrain_file;
 
 use std::{path::Path, time::Instant};
 
@@ -29,6 +30,7 @@ use self::{
     detail::{DetailRule, PatchHeights},
     heights::{area_weight, FaceLattice},
     mountains::seed_mountains,
+    terrain_file::{TerrainFile, TerrainFileError},
 };
 use crate::{
     config::{Config, ReliefModel, RiverModel},
@@ -61,6 +63,8 @@ pub fn direction_at(lon: f64, lat: f64) -> DVec3 {
 pub enum PlanetError {
     #[error(transparent)]
     Continents(#[from] ContinentError),
+    #[error(transparent)]
+    TerrainFile(#[from] TerrainFileError),
     #[error("base-resolution {base} {rule}")]
     BaseResolution { base: u32, rule: String },
 }
@@ -151,6 +155,20 @@ impl Planet {
             amplitude: p.detail_amplitude,
         };
 
+        // Heights from a file (beyond the thesis): read and checked before any work.
+        let t = Instant::now();
+        let terrain = match p.relief_model {
+            ReliefModel::File => Some(TerrainFile::load(
+                Path::new(&p.terrain_file),
+                (p.terrain_height_scale, p.terrain_height_offset),
+                p.sea_level_height,
+            )?),
+            _ => None,
+        };
+        if terrain.is_some() {
+            time("terrain file", t);
+        }
+
         // Continents on the base lattice (4.1).
         let t = Instant::now();
         let base = FaceLattice::new(base_cells, 0.0);
@@ -167,7 +185,21 @@ impl Planet {
             .collect();
         // The continent map as a function of a threshold: an image gives land directly; the Voronoi diagram gives
         // each point's ratio of continental to water distance, and a weight turns ratios into land.
-        let (image_land, ratios, features) = if p.continents_from_file {
+        // A terrain file's heights at the base lattice's points, which give its land and sea.
+        let file_heights: Option<Vec<f32>> = terrain.as_ref().map(|terrain| {
+            points
+                .par_iter()
+                .map(|&(f, i, j)| terrain.height_towards(base.direction(base.key(f, i, j))) as f32)
+                .collect()
+        });
+        let (image_land, ratios, features) = if let Some(heights) = &file_heights {
+            let sea_level = p.sea_level_height;
+            (
+                Some(heights.iter().map(|&h| h > sea_level).collect()),
+                Vec::new(),
+                None,
+            )
+        } else if p.continents_from_file {
             let image = ContinentImage::load(Path::new(&p.continents_image))?;
             let land: Vec<bool> = points
                 .par_iter()
@@ -241,10 +273,10 @@ impl Planet {
             let mut base = FaceLattice::new(base_cells, 0.0);
             for (k, &(f, i, j)) in points.iter().enumerate() {
                 let index = base.index(f, i, j);
-                base.data[index] = if land[k] {
-                    p.continent_height
-                } else {
-                    p.ocean_height
+                base.data[index] = match (&file_heights, land[k]) {
+                    (Some(heights), _) => heights[k],
+                    (None, true) => p.continent_height,
+                    (None, false) => p.ocean_height,
                 };
             }
             let (mountains, drainage) = match &grid {
@@ -265,6 +297,8 @@ impl Planet {
                                 seed64,
                             ))
                         }
+                        // The file's heights are the relief.
+                        ReliefModel::File => {}
                         _ => relief::raise(&mut base, grid, p, seed64),
                     }
                     time("relief", t);
@@ -296,7 +330,7 @@ impl Planet {
                         seed,
                         landmass_percent: landmass * 100.0,
                         continent_percent: continent_share * 100.0,
-                        continents: if p.continents_from_file {
+                        continents: if p.continents_from_file || terrain.is_some() {
                             0
                         } else {
                             p.continents as usize

@@ -14,7 +14,7 @@ use super::{
     spline::{rotate, Hermite},
 };
 use crate::{
-    config::{Config, ReliefModel, RiverModel},
+    config::{Config, RiverModel},
     drainage::meanders,
     rng::{self, Rng},
 };
@@ -139,7 +139,7 @@ impl SubdivisionParams {
             tributary_probability: config.river.tributary_probability as f64,
             min_width: config.river.min_width,
             meander_relief_slope: (config.river.model == RiverModel::Drainage
-                && config.planet.relief_model == ReliefModel::Eroded
+                && config.planet.relief_model.has_valleys()
                 && config.river.fine_meanders)
                 .then(|| {
                     (config.planet.max_mountain_height - config.planet.sea_level_height) as f64
