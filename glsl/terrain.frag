@@ -228,6 +228,15 @@ float distanceSlope(vec2 dz) {
 // Beyond the thesis: the largest slope at which an interpolated distance is taken for a river's (sqrt 2 and a
 // margin for the curvature of the mesh on the sphere).
 const float RIVER_SLOPE_LIMIT = 1.6;
+// Beyond the thesis: the smallest slope at which an interpolated distance is taken for a river's, on a triangle
+// more than RIVER_FLAT_SPACING half widths across. Across one river the signed distance changes by one unit per
+// unit of length; where a large triangle's vertices measured a river's end, a confluence's two branches or the far
+// sides of a bend, their distances are alike, the interpolant is nearly flat and its band |distance| < half width
+// spreads over the whole triangle: from orbit, angular blobs of painted water many times a river's width
+// (docs/rendering.md, "Blobs of painted water"). On a triangle about as wide as the river a flat interpolant is a
+// confluence's water, which stays. Half the unit slope is a bend of 120 degrees within one triangle.
+const float RIVER_SLOPE_FLOOR = 0.5;
+const float RIVER_FLAT_SPACING = 4.0;
 // Beyond the thesis: the largest change of the river half width per unit of length at which a triangle is taken
 // to measure one river. Along one river the width changes by a fraction of a percent per unit; a triangle with a
 // vertex nearest a finer level's stream (its own narrow width, docs/kernel.md) and one nearest the wide river
@@ -259,7 +268,9 @@ void main() {
     float shoreEdge = fwidth(fRiver.x) + 1e-6;
     float bankEdge = fwidth(fRiver.y - fRiver.x) + 1e-6;
     vec2 dw = vec2(dFdx(fRiver.w), dFdy(fRiver.w));
-    bool measured = distanceSlope(dz) <= RIVER_SLOPE_LIMIT && distanceSlope(dw) <= WIDTH_SLOPE_LIMIT;
+    float zSlope = distanceSlope(dz);
+    bool flatDistance = zSlope < RIVER_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * fRiver.w;
+    bool measured = zSlope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw) <= WIDTH_SLOPE_LIMIT;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).

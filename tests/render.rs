@@ -219,6 +219,38 @@ fn painted_rivers_lie_where_the_rivers_are_at_any_level_of_detail() {
     common::assert_no_validation_errors(ctx);
 }
 
+/// Beyond the thesis: from orbit, painted rivers are lines, not blobs. A triangle many times wider than a river
+/// whose vertices measured a river's end or a confluence's two branches interpolates a nearly flat distance, and
+/// painted its whole area (docs/rendering.md, "Blobs of painted water"): 2,075 of the 12,308 pixels painted in seed
+/// 1's orbit at 1280x720 lay at the centre of a painted 5x5 square before the slope floor in terrain.frag, none of
+/// 5,375 after (the widest river is about 3 pixels wide there).
+#[test]
+fn painted_rivers_from_orbit_are_lines_not_blobs() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = world();
+    let size = [1280, 720];
+    let camera = preset_camera(Preset::Orbit, size[0] as f64 / size[1] as f64);
+    let red = paint_rivers_red(
+        ctx,
+        (world, &camera),
+        size,
+        &world.config,
+        LodRule::ScreenSpaceError,
+        "blobs",
+        0,
+    );
+    let (width, height) = (size[0] as usize, size[1] as usize);
+    let cores = (2..height - 2)
+        .flat_map(|y| (2..width - 2).map(move |x| (x, y)))
+        .filter(|&(x, y)| (y - 2..=y + 2).all(|v| (x - 2..=x + 2).all(|u| red[v * width + u])))
+        .count();
+    let painted = red.iter().filter(|&&r| r).count();
+    eprintln!("{painted} painted pixels from orbit, {cores} at the centre of a painted 5x5 square");
+    assert!(painted > 0, "no river painted from orbit");
+    assert_eq!(cores, 0, "painted blobs from orbit (see painted-blobs-0-*.png)");
+    common::assert_no_validation_errors(ctx);
+}
+
 /// Beyond the thesis: the screen-space rule (the default) keeps the water a coarse level would lose. From orbit,
 /// level 0's vertices are 64 units apart, more than twice the influence distance, so the lakes between them
 /// reached no vertex and were not drawn; with the river data's error in the rule the orbit draws as much water as
