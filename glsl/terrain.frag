@@ -6,6 +6,10 @@
 #include "atmosphere.glsl"
 
 layout(constant_id = 0) const uint WATER_PASS = 0;
+// Beyond the thesis: 1 in the pipeline that draws the patches a lake of the lake map reaches (docs/rendering.md,
+// "Lakes from afar"); 0 elsewhere, where the lake map's code is compiled out (its mere presence cost lavapipe 7 to
+// 11 % of the terrain pass).
+layout(constant_id = 1) const uint LAKE_MAP = 0;
 
 #include "terrain_interface.glsl"
 
@@ -215,10 +219,8 @@ vec3 rippleSpace(bool river, out vec2 visible) {
 // at most sqrt(2) (a right triangle's interpolant of a 1-Lipschitz field). Where they measure different rivers, or
 // one measures none (the influence distance's default) or sits beyond a river's end (the sign flips there), the
 // vertices' distances differ by more than their separation and the interpolant crosses zero where no river is.
-// `dz`: the distance's screen derivatives (or another interpolant's: riverSlope). Call in uniform control flow.
-float distanceSlope(vec2 dz) {
-    vec3 px = dFdx(fPosition);
-    vec3 py = dFdy(fPosition);
+// `dz`: the distance's screen derivatives (or another interpolant's: riverSlope); `px`, `py`: the position's.
+float distanceSlope(vec2 dz, vec3 px, vec3 py) {
     float a = dot(px, px), b = dot(px, py), c = dot(py, py);
     // |grad z|^2 on the triangle's plane: dz G^-1 dz with G the Gram matrix of the screen derivatives.
     float g2 = (c * dz.x * dz.x - 2.0 * b * dz.x * dz.y + a * dz.y * dz.y) / max(a * c - b * b, 1e-30);
@@ -244,6 +246,31 @@ const float RIVER_FLAT_SPACING = 4.0;
 // river's.
 const float WIDTH_SLOPE_LIMIT = 0.25;
 
+// Beyond the thesis (docs/rendering.md, "Lakes from afar"): the cube faces' axes (normal, u, v; planet/cube.rs
+// FACE_AXES), the lake map's layers.
+const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1),
+                                   vec3(0, 0, -1));
+const vec3 FACE_U[6] = vec3[](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0), vec3(1, 0, 0), vec3(1, 0, 0),
+                              vec3(-1, 0, 0));
+const vec3 FACE_V[6] = vec3[](vec3(0, 1, 0), vec3(0, 1, 0), vec3(0, 0, -1), vec3(0, 0, 1), vec3(0, 1, 0),
+                              vec3(0, 1, 0));
+
+// The lake map's texture coordinate towards direction `d` (the face it points through, ties to the lowest face as
+// planet/cube.rs face_of) on a map of `side` texels per face edge, one per lattice point.
+vec3 lakeMapCoord(vec3 d, float side) {
+    vec3 a = abs(d);
+    int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1)
+             : a.y >= a.z               ? (d.y >= 0.0 ? 2 : 3)
+                                        : (d.z >= 0.0 ? 4 : 5);
+    vec3 p = d / dot(d, FACE_NORMAL[face]);
+    vec2 uv = vec2(dot(p, FACE_U[face]), dot(p, FACE_V[face]));
+    return vec3(((uv + 1.0) * 0.5 * (side - 1.0) + 0.5) / side, float(face));
+}
+
+// Beyond the thesis: a vertex a lake reaches reports a half width of 1e9 (docs/kernel.md, "Lakes"), so a triangle
+// with one has an interpolated half width far above any river's.
+const float LAKE_HALF_WIDTH_FLOOR = 1e6;
+
 void main() {
     vec3 sun = normalize(frame.sun.xyz);
     vec3 up = normalize(fDirection);
@@ -267,10 +294,14 @@ void main() {
     float edge = abs(dz.x) + abs(dz.y) + 1e-4;
     float shoreEdge = fwidth(fRiver.x) + 1e-6;
     float bankEdge = fwidth(fRiver.y - fRiver.x) + 1e-6;
+    vec3 px = dFdx(fPosition);
+    vec3 py = dFdy(fPosition);
+    // The pixel's footprint on the surface (world units), for the lakes drawn from the lake map.
+    float footprint = sqrt(max(dot(px, px), dot(py, py)));
     vec2 dw = vec2(dFdx(fRiver.w), dFdy(fRiver.w));
-    float zSlope = distanceSlope(dz);
+    float zSlope = distanceSlope(dz, px, py);
     bool flatDistance = zSlope < RIVER_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * fRiver.w;
-    bool measured = zSlope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw) <= WIDTH_SLOPE_LIMIT;
+    bool measured = zSlope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw, px, py) <= WIDTH_SLOPE_LIMIT;
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).
@@ -298,13 +329,42 @@ void main() {
     float underSea = inMesh ? 1.0 - smoothBand(-shoreEdge, shoreEdge, fRiver.x - sea) : 0.0;
     float inRiver = inMesh && !paint && fNearBasin > 0.0
                   ? inBasin * smoothBand(-bankEdge, bankEdge, fRiver.y - fRiver.x) : 0.0;
+    // Beyond the thesis (docs/rendering.md, "Lakes from afar"): on patches coarser than the precomputed lattice,
+    // lakes from the lake map (how far each lattice point lies below the level of the lake that reaches it), to the
+    // bilinear contour at their level, in place of the water the coarse mesh's few lake vertices would show. Only
+    // there, in patches a lake reaches (drawn by the pipeline with LAKE_MAP 1) and above the sea, is the map read
+    // (finer patches draw their lakes in the mesh): one gather, no
+    // implicit derivative, so the branch may differ within a quad; the contour is antialiased over the pixel's
+    // footprint (taken above, in uniform control flow) times the map's gradient.
+    int lakeSlot = lakeMapSlot();
+    float lakeCover = 0.0;
+    float lakeDepth = 0.0;
+    float mapSpacing = frame.planet.x * 1.5707963 / lakeMapCells();
+    if (LAKE_MAP == 1u && lakeSlot >= 0 && inMesh && mode == WATER_AUTO && fSpacing > mapSpacing && underSea == 0.0) {
+        float side = lakeMapCells() + 1.0;
+        vec3 coord = lakeMapCoord(up, side);
+        vec4 texels = textureGather(patchTextures[lakeSlot], coord, 0);
+        vec2 f = fract(coord.xy * side - 0.5);
+        // Gather order: (0, 1), (1, 1), (1, 0), (0, 0).
+        float below = mix(mix(texels.w, texels.z, f.x), mix(texels.x, texels.y, f.x), f.y);
+        vec2 gradient = vec2(mix(texels.z - texels.w, texels.y - texels.x, f.y),
+                             mix(texels.x - texels.w, texels.y - texels.z, f.x)) / mapSpacing;
+        float lakeEdge = length(gradient) * footprint + 1e-6;
+        float coarse = smoothBand(mapSpacing, 2.0 * mapSpacing, fSpacing);
+        lakeCover = coarse * smoothBand(-lakeEdge, lakeEdge, below);
+        lakeDepth = below;
+        if (fRiver.w > LAKE_HALF_WIDTH_FLOOR) inRiver *= 1.0 - coarse;
+    }
     bool seaWater = underSea > 0.0;
-    float cover = seaWater ? underSea : max(inRiver, painted);
+    bool lakeWater = !seaWater && lakeCover > max(inRiver, painted);
+    float cover = seaWater ? underSea : max(max(inRiver, painted), lakeCover);
     // One evaluation of the water's surface for whichever water this pixel shows.
     if (cover > 0.0) {
-        bool paintedWater = !seaWater && painted > 0.0;
-        float depth = seaWater ? sea - fRiver.x : paintedWater ? 0.5 * frame.extra.z : fRiver.y - fRiver.x;
-        vec4 water = waterSurface(!seaWater, max(depth, 0.0), seaWater ? seaQ : q, seaWater ? seaVisible : visible, up,
+        bool paintedWater = !seaWater && !lakeWater && painted > 0.0;
+        bool standing = seaWater || lakeWater;
+        float depth = seaWater ? sea - fRiver.x : lakeWater ? lakeDepth : paintedWater ? 0.5 * frame.extra.z
+                                                                        : fRiver.y - fRiver.x;
+        vec4 water = waterSurface(!standing, max(depth, 0.0), standing ? seaQ : q, standing ? seaVisible : visible, up,
                                   view, sun);
         // Painted rivers are opaque (the thesis's painting).
         if (paintedWater) water.a = 1.0;

@@ -9,7 +9,8 @@ layout(push_constant) uniform FramePush {
     vec4 sun;
     // x: radius; y: vertices per patch edge; z: water mode (0 auto, 1 geometry, 2 painted) + 4 x view (0 shaded,
     // 1 level-of-detail colours, 2 painted rivers shown red) + 16 if the water is still + 32 if the water is part
-    // of the terrain mesh; w: the lowest height any terrain can have.
+    // of the terrain mesh + 64 x (the lake map's slot + 1, 0 without lakes; below 2^14) + 2^20 x log2 of the lake
+    // map's cells per face edge; w: the lowest height any terrain can have.
     vec4 planet;
     // x: the atmosphere's transmittance table slot, or -1 without atmosphere; y: time in seconds (the water's
     // flow); z: height unit of the colour bands (max-mountain-height / 16, so that Appendix A's planet, whose
@@ -25,6 +26,9 @@ bool stillWater() { return (uint(frame.planet.z) & 16u) != 0u; }
 // Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the terrain pass draws the water, its
 // vertices under water raised to the water's surface; no water pass.
 bool waterInMesh() { return (uint(frame.planet.z) & 32u) != 0u; }
+// Beyond the thesis (docs/rendering.md, "Lakes from afar"): the slot of the lakes' depth map, or -1.
+int lakeMapSlot() { return int((uint(frame.planet.z) >> 6) & 0x3fffu) - 1; }
+float lakeMapCells() { return float(1u << (uint(frame.planet.z) >> 20)); }
 
 const uint WATER_AUTO = 0;
 const uint WATER_GEOMETRY = 1;

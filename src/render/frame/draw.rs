@@ -215,6 +215,7 @@ impl Renderer<'_> {
                 wet,
                 patch: s.patch,
                 culled: !self.reaches_switch_distance(s.patch, range, camera.position),
+                lakes: self.lake_map.as_ref().is_some_and(|m| m.has_lakes(s.patch)),
             });
         }
         // Near to far, so that depth testing rejects what nearer patches hide before it is shaded.
@@ -237,10 +238,11 @@ impl Renderer<'_> {
         let mut instance_patches: Vec<PatchId> = Vec::with_capacity(drawn.len() * 2);
         // The terrain's draws: each quadrant's cells and edge skirts for the instances that draw it, and its
         // midline skirts only for those that leave the quadrant across the midline to finer patches; each once for
-        // the patches whose back faces are culled and once for those reaching their switch distance.
+        // the patches whose back faces are culled and once for those reaching their switch distance, and each of
+        // those apart for the patches a lake of the lake map reaches.
         let has = |d: &DrawnPatch, q: usize| d.instance.slots[2] & (1 << q) != 0;
-        let mut terrain_draws: Vec<(Range<u32>, Range<u32>, bool)> = Vec::with_capacity(24);
-        for cull in [true, false] {
+        let mut terrain_draws: Vec<(Range<u32>, Range<u32>, bool, bool)> = Vec::with_capacity(48);
+        for (cull, lakes) in [(true, false), (false, false), (true, true), (false, true)] {
             for (q, mesh) in self.quadrants.iter().enumerate() {
                 let parts = [
                     (mesh.core.clone(), None),
@@ -250,12 +252,15 @@ impl Renderer<'_> {
                 for (indices, across) in parts {
                     let first = instances.len() as u32;
                     for d in drawn.iter().filter(|d| {
-                        d.culled == cull && has(d, q) && across.is_none_or(|a| !has(d, a))
+                        d.culled == cull
+                            && d.lakes == lakes
+                            && has(d, q)
+                            && across.is_none_or(|a| !has(d, a))
                     }) {
                         instances.push(d.instance);
                         instance_patches.push(d.patch);
                     }
-                    terrain_draws.push((indices, first..instances.len() as u32, cull));
+                    terrain_draws.push((indices, first..instances.len() as u32, cull, lakes));
                 }
             }
         }
@@ -348,14 +353,15 @@ impl Renderer<'_> {
         rec.use_attachment(target, Attachment::Depth, &[Access::DepthAttachment], true);
         rec.begin_rendering(target, true);
         self.frames.profiler().scope(rec, "terrain", |rec| {
-            for (indices, instances, cull) in terrain_draws {
+            for (indices, instances, cull, lakes) in terrain_draws {
                 if instances.is_empty() {
                     continue;
                 }
-                let terrain = match (self.wireframe_on, cull) {
-                    (true, _) => &self.wireframe,
-                    (false, true) => &self.terrain,
-                    (false, false) => &self.terrain_unculled,
+                let terrain = match (self.wireframe_on, cull, &self.terrain_lakes) {
+                    (true, _, _) => &self.wireframe,
+                    (false, _, Some(pipelines)) if lakes => &pipelines[!cull as usize],
+                    (false, true, _) => &self.terrain,
+                    (false, false, _) => &self.terrain_unculled,
                 };
                 stats.terrain_triangles += (indices.len() / 3 * instances.len()) as u64;
                 rec.draw_indexed(terrain, &sets, push, &self.indices, indices, instances);
@@ -449,6 +455,8 @@ struct DrawnPatch {
     patch: PatchId,
     /// Whether its back faces are culled (not where morphing can leave walls: `reaches_switch_distance`).
     culled: bool,
+    /// Whether a lake of the lake map lies in it: drawn by the terrain pipelines that read the map.
+    lakes: bool,
 }
 
 /// The visible patches drawn from an ancestor's data with the span of that ancestor's heights, and for every

@@ -5,6 +5,7 @@
 
 mod draw;
 mod inflight;
+mod lake_map;
 mod modes;
 mod plan;
 mod resident;
@@ -97,12 +98,17 @@ pub struct Renderer<'w> {
     /// The terrain without back-face culling, for patches that reach their switch distance (draw.rs,
     /// `reaches_switch_distance`).
     terrain_unculled: GraphicsPipeline,
+    /// The terrain's two pipelines (back faces culled, not culled) with the lake map's code compiled in, for the
+    /// patches a lake of the map reaches (`LAKE_MAP` in terrain.frag); `None` without a lake map.
+    terrain_lakes: Option<[GraphicsPipeline; 2]>,
     water: GraphicsPipeline,
     /// The water of patches in the vertex cache, from the triangles its passes list (no geometry shader).
     cached_water: GraphicsPipeline,
     wireframe: GraphicsPipeline,
     /// The atmosphere's table and sky pass; `None` for a planet without air (`atmosphere-height` 0).
     sky: Option<sky::Sky>,
+    /// How far below its lake each precomputed lattice point lies, for the coarse patches; `None` without lakes.
+    lake_map: Option<lake_map::LakeMap>,
     instance_layout: BufferSetLayout,
     /// Bound in place of the vertex capture when vertices are not captured, of the water pass's draws and
     /// indices when the terrain mesh carries the water, and of the sky dome's vertices when no sky is drawn.
@@ -208,7 +214,7 @@ impl<'w> Renderer<'w> {
         // through them (docs/rendering.md, "Back faces and morphing"); the water pass has the geometry shader that
         // spawns water triangles, except for the cached patches, whose water triangles the vertex cache's passes
         // list (docs/rendering.md). Water is blended over the terrain, writes no depth and comes in either winding.
-        let pipeline = |name: &str, vertex, geometry, kind: SurfacePipeline| {
+        let pipeline = |name: &str, vertex, geometry, kind: SurfacePipeline, lakes: bool| {
             let water = kind == SurfacePipeline::Water;
             GraphicsPipeline::new(
                 ctx,
@@ -219,7 +225,7 @@ impl<'w> Renderer<'w> {
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
                     push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                    specialization: bytemuck::bytes_of(&(water as u32)),
+                    specialization: bytemuck::bytes_of(&[water as u32, lakes as u32]),
                     color_format,
                     depth_format,
                     depth_write: !water,
@@ -234,17 +240,35 @@ impl<'w> Renderer<'w> {
             )
         };
         use SurfacePipeline::{Culled, Unculled, Water, Wireframe};
-        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, Culled)?;
-        let terrain_unculled =
-            pipeline("terrain, not culled", shaders::TERRAIN_VERT, None, Unculled)?;
+        let terrain = pipeline("terrain", shaders::TERRAIN_VERT, None, Culled, false)?;
+        let terrain_unculled = pipeline(
+            "terrain, not culled",
+            shaders::TERRAIN_VERT,
+            None,
+            Unculled,
+            false,
+        )?;
         let water = pipeline(
             "water",
             shaders::WATER_VERT,
             Some(shaders::TERRAIN_GEOM),
             Water,
+            false,
         )?;
-        let cached_water = pipeline("cached water", shaders::WATER_SURFACE_VERT, None, Water)?;
-        let wireframe = pipeline("terrain wireframe", shaders::TERRAIN_VERT, None, Wireframe)?;
+        let cached_water = pipeline(
+            "cached water",
+            shaders::WATER_SURFACE_VERT,
+            None,
+            Water,
+            false,
+        )?;
+        let wireframe = pipeline(
+            "terrain wireframe",
+            shaders::TERRAIN_VERT,
+            None,
+            Wireframe,
+            false,
+        )?;
         let air = Atmosphere::new(
             planet.radius,
             planet.sea_level as f64,
@@ -261,6 +285,28 @@ impl<'w> Renderer<'w> {
                 )
             })
             .transpose()?;
+        let lakes = planet.drainage.as_ref().map_or(&[][..], |d| &d.lakes[..]);
+        let lake_map = lake_map::LakeMap::new(
+            ctx,
+            &mut bindless,
+            &planet.lattice,
+            lakes,
+            planet.radius,
+            (planet.stats.max_height - planet.stats.min_height).max(f32::MIN_POSITIVE),
+        )?;
+        let terrain_lakes = match lake_map {
+            Some(_) => Some([
+                pipeline("terrain, lakes", shaders::TERRAIN_VERT, None, Culled, true)?,
+                pipeline(
+                    "terrain, lakes, not culled",
+                    shaders::TERRAIN_VERT,
+                    None,
+                    Unculled,
+                    true,
+                )?,
+            ]),
+            None => None,
+        };
         let PatchMesh {
             indices: mesh,
             quadrants,
@@ -285,10 +331,12 @@ impl<'w> Renderer<'w> {
             refiner,
             terrain,
             terrain_unculled,
+            terrain_lakes,
             water,
             cached_water,
             wireframe,
             sky,
+            lake_map,
             instance_layout,
             placeholder,
             vertex_cache,

@@ -48,7 +48,8 @@ impl Renderer<'_> {
                 (self.water_mode as u32
                     + 4 * view_mode
                     + 16 * !self.flowing_water as u32
-                    + 32 * self.draws_water_in_mesh(camera) as u32) as f32,
+                    + 32 * self.draws_water_in_mesh(camera) as u32
+                    + self.lake_map.as_ref().map_or(0, |m| m.bits())) as f32,
                 self.heights.min as f32,
             ],
             extra: [
