@@ -43,6 +43,24 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// Seed 1 of config/planet.xml as `export equirect --size SIZE --format FORMAT` writes it, to `dir/world.EXT`.
+fn export_world(dir: &Path, size: &str, format: &str, extension: &str) -> PathBuf {
+    let path = dir.join(format!("world.{extension}"));
+    succeeds(&[
+        "export",
+        "equirect",
+        "--seed",
+        "1",
+        "--size",
+        size,
+        "--format",
+        format,
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    path
+}
+
 /// config/planet.xml with its relief from `terrain` (relative to the configuration's folder) and `extra` elements.
 fn file_config(dir: &Path, terrain: &str, extra: &str) -> PathBuf {
     let default =
@@ -106,17 +124,7 @@ impl RiverPoints {
 #[test]
 fn a_planet_exported_and_read_back_is_the_same_planet() {
     let dir = temp_dir("round-trip");
-    let tif = dir.join("world.tif");
-    succeeds(&[
-        "export",
-        "equirect",
-        "--seed",
-        "1",
-        "--size",
-        "1024x512",
-        "--out",
-        tif.to_str().unwrap(),
-    ]);
+    export_world(&dir, "1024x512", "tiff", "tif");
     let original = planet(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml"));
     let read_back = planet(&file_config(&dir, "world.tif", ""));
 
@@ -191,19 +199,7 @@ fn a_planet_exported_and_read_back_is_the_same_planet() {
 fn every_format_export_writes_reads_back_alike() {
     let dir = temp_dir("formats");
     let read = |format: &str, extension: &str| {
-        let path = dir.join(format!("world.{extension}"));
-        succeeds(&[
-            "export",
-            "equirect",
-            "--seed",
-            "1",
-            "--size",
-            "256x128",
-            "--format",
-            format,
-            "--out",
-            path.to_str().unwrap(),
-        ]);
+        let path = export_world(&dir, "256x128", format, extension);
         TerrainFile::load(&path, (1.0, 0.0), 0.4).unwrap()
     };
     let (tiff, exr, png) = (read("tiff", "tif"), read("exr", "exr"), read("png", "png"));
@@ -340,17 +336,7 @@ fn a_planet_from_a_file_renders_and_descends() {
         return;
     }
     let dir = temp_dir("descent");
-    let tif = dir.join("world.tif");
-    succeeds(&[
-        "export",
-        "equirect",
-        "--seed",
-        "1",
-        "--size",
-        "512x256",
-        "--out",
-        tif.to_str().unwrap(),
-    ]);
+    export_world(&dir, "512x256", "tiff", "tif");
     let config = file_config(&dir, "world.tif", "");
     let json = dir.join("flight.json");
     let out = Command::new(env!("CARGO_BIN_EXE_riverplanet"))
