@@ -69,9 +69,14 @@ impl LakeMap {
             rec.use_images(&[&image], &[Access::GraphicsSampled]);
             Ok(())
         })?;
-        let slot = bindless.allocate(ctx).ok_or_else(|| {
-            GpuError::Invalid("no bindless slot left for the lake map".to_string())
-        })?;
+        // The slot travels in the push constants' f32 above six mode bits and below the cells' exponent
+        // (`bits`): the renderer takes it before any patch's, so it is small.
+        let slot = bindless
+            .allocate(ctx)
+            .filter(|slot| slot.0 + 1 < 1 << 14)
+            .ok_or_else(|| {
+                GpuError::Invalid("no bindless slot below 16383 for the lake map".to_string())
+            })?;
         bindless.write(ctx, slot, &image, false);
         let cells_log2 = lattice.cells.trailing_zeros();
         Ok(Some(Self {
@@ -95,7 +100,6 @@ impl LakeMap {
     /// What the push constants carry of the map (`planet.z` above its six mode bits, glsl/terrain_common.glsl):
     /// 64 x (slot + 1) and 2^20 x log2 of its cells per face edge, each exact in the f32 it travels in.
     pub(super) fn bits(&self) -> u32 {
-        assert!(self.slot.0 + 1 < 1 << 14 && self.cells_log2 < 16);
         64 * (self.slot.0 + 1) + (self.cells_log2 << 20)
     }
 }
