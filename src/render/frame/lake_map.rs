@@ -31,7 +31,8 @@ pub(super) struct LakeMap {
 }
 
 impl LakeMap {
-    /// Uploads the lake depths of `lakes` over `lattice` (the planet's precomputed heights); `None` without lakes.
+    /// Uploads the lake depths of `lakes` over `lattice` (the planet's precomputed heights, of patch level
+    /// `map_level`); `None` without lakes.
     pub(super) fn new(
         ctx: &Context,
         bindless: &mut Bindless,
@@ -39,6 +40,7 @@ impl LakeMap {
         lakes: &[LakeShape],
         radius: f64,
         relief: f32,
+        map_level: u32,
     ) -> Result<Option<Self>, GpuError> {
         if lakes.is_empty() {
             return Ok(None);
@@ -83,7 +85,7 @@ impl LakeMap {
             _image: image,
             slot,
             cells_log2,
-            patches_with_lakes: patches_with_lakes(&depths, cells_log2, relief),
+            patches_with_lakes: patches_with_lakes(&depths, map_level, relief),
         }))
     }
 
@@ -104,37 +106,37 @@ impl LakeMap {
     }
 }
 
-/// For every level coarser than `depths` (2^`cells_log2` cells per face edge; patch grids of 2^level per face edge),
-/// whether a point a lake reaches (above `-relief`) lies in each patch, its borders included.
-fn patches_with_lakes(depths: &FaceLattice, cells_log2: u32, relief: f32) -> Vec<Vec<bool>> {
+/// For every patch level below `levels` (those coarser than the map: the precomputed level; patch grids of 2^level
+/// per face edge), whether a point a lake reaches (above `-relief`) lies in each patch, its borders included.
+fn patches_with_lakes(depths: &FaceLattice, levels: u32, relief: f32) -> Vec<Vec<bool>> {
     let side = depths.side();
-    (0..cells_log2)
-        .map(|level| {
-            let per_edge = 1usize << level;
-            let cells_per_patch = (depths.cells >> level) as usize;
-            let mut flags = vec![false; FACES * per_edge * per_edge];
-            for face in 0..FACES {
-                for j in 0..side {
-                    for i in 0..side {
-                        if depths.data[depths.index(face, i as u32, j as u32)] <= -relief {
-                            continue;
-                        }
-                        // The patches whose closed range holds the point (two or four on their borders).
-                        let range = |t: usize| {
-                            let first = t.saturating_sub(1) / cells_per_patch;
-                            first..=(t / cells_per_patch).min(per_edge - 1)
-                        };
-                        for y in range(j) {
-                            for x in range(i) {
-                                flags[(face * per_edge + y) * per_edge + x] = true;
-                            }
+    let mut flags: Vec<Vec<bool>> = (0..levels)
+        .map(|level| vec![false; FACES << (2 * level)])
+        .collect();
+    for face in 0..FACES {
+        for j in 0..side {
+            for i in 0..side {
+                if depths.data[depths.index(face, i as u32, j as u32)] <= -relief {
+                    continue;
+                }
+                for (level, flags) in flags.iter_mut().enumerate() {
+                    let per_edge = 1usize << level;
+                    let cells_per_patch = (depths.cells >> level) as usize;
+                    // The patches whose closed range holds the point (two or four on their borders).
+                    let range = |t: usize| {
+                        let first = t.saturating_sub(1) / cells_per_patch;
+                        first..=(t / cells_per_patch).min(per_edge - 1)
+                    };
+                    for y in range(j) {
+                        for x in range(i) {
+                            flags[(face * per_edge + y) * per_edge + x] = true;
                         }
                     }
                 }
             }
-            flags
-        })
-        .collect()
+        }
+    }
+    flags
 }
 
 /// Per point of `lattice`: the level of the highest lake whose reach covers it (a base cell from the lake's

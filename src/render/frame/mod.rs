@@ -293,6 +293,7 @@ impl<'w> Renderer<'w> {
             lakes,
             planet.radius,
             (planet.stats.max_height - planet.stats.min_height).max(f32::MIN_POSITIVE),
+            planet.precomputed_level,
         )?;
         let terrain_lakes = match lake_map {
             Some(_) => Some([
