@@ -186,6 +186,19 @@ fn the_interior_rise_lies_between_0_and_20() {
 }
 
 #[test]
+fn the_network_diffusivity_lies_between_0_and_a_thousandth() {
+    for bad in ["-1e-4", "0.002", "nan"] {
+        let msg = error_of(&with("planet-attributes", "network-diffusivity", bad));
+        assert!(
+            msg.contains("<network-diffusivity>") && msg.contains("[0, 0.001]"),
+            "{msg}"
+        );
+    }
+    let planet = Config::defaults_for(RiverModel::Drainage).planet;
+    assert_eq!(planet.network_diffusivity, 0.0);
+}
+
+#[test]
 fn landmass_must_lie_strictly_between_0_and_100() {
     for bad in ["0", "100", "-1", "150.0f"] {
         let msg = error_of(&with("planet-attributes", "landmass-percentage", bad));

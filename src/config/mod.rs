@@ -70,6 +70,9 @@ pub struct PlanetConfig {
     /// Eroded relief (beyond the thesis): the lowlands' uplift grows inland by this share of itself per radian
     /// from the sea, so continental interiors stand higher than their coastal plains (0: one lowland uplift).
     pub interior_rise: f32,
+    /// Eroded relief (beyond the thesis): hillslope diffusivity of the young relief while its drainage network
+    /// forms (unit-sphere area per model time; 0, the default: the rivers alone).
+    pub network_diffusivity: f32,
     /// Relief `file` (beyond the thesis): the whole planet's heights as an equirectangular raster (TIFF, OpenEXR or
     /// 16-bit PNG; docs/planet.md, "Heights from a file"); in a file, relative to the file's folder.
     pub terrain_file: String,
@@ -280,6 +283,7 @@ impl Config {
                 base_resolution: 129,
                 relief_model: ReliefModel::Thesis,
                 interior_rise: 0.0,
+                network_diffusivity: 0.0,
                 terrain_file: String::new(),
                 terrain_height_scale: 1.0,
                 terrain_height_offset: 0.0,

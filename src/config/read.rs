@@ -129,6 +129,9 @@ const PLANET: &[Param<PlanetConfig>] = &[
     Param::Number("interior-rise", Range::Closed(0.0, 20.0), |c| {
         &mut c.interior_rise
     }),
+    Param::Number("network-diffusivity", Range::Closed(0.0, 1e-3), |c| {
+        &mut c.network_diffusivity
+    }),
     Param::Path("terrain-file", |c| &mut c.terrain_file),
     Param::Number("terrain-height-scale", Range::Positive, |c| {
         &mut c.terrain_height_scale

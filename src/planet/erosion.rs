@@ -5,6 +5,10 @@
 //! its steady state. Ridges, valleys, divides and river profiles then come from one model, and the drainage
 //! network the rivers are later cut from is the one the erosion made.
 //!
+//! While the network forms, hillslope diffusion acts beside the rivers (`dh/dt = U - K A^m S + D lap h`), so
+//! neighbouring valleys compete and the smaller ones are captured, as branching networks form (Perron et al.
+//! 2012); afterwards the rivers alone shape the relief towards its steady state (docs/planet.md).
+//!
 //! The model runs without units and is scaled at the end: with n = 1 the steady state is linear in U / K, so a
 //! scale factor changes no shape, no slope-area exponent and no network.
 
@@ -36,6 +40,11 @@ const FIRST_STEP: f64 = 0.002;
 const STEP_GROWTH: f64 = 1.6;
 const LONGEST_STEP: f64 = 2.0;
 const STEPS: usize = 36;
+/// The model time over which the young relief diffuses while its network forms (the first 14 of the
+/// [`STEPS`] steps, about a 25th of the evolution); the later, long steps are the stream-power law's alone.
+const NETWORK_FORMING_TIME: f64 = 1.0;
+/// Explicit diffusion substeps keep `dt D sum(1 / angle^2)` below this (stable below 1/2).
+const DIFFUSION_STABILITY: f64 = 0.4;
 /// Heights of the initial plain's random roughness (model units; the steady state's relief is about 1 to 10).
 const INITIAL_ROUGHNESS: f64 = 0.02;
 
@@ -80,7 +89,8 @@ pub fn raise(
     let CoastDistances { to_sea, to_land } = CoastDistances::new(grid, &land);
     let uplift = uplift(grid, &land, &to_sea, planet.interior_rise as f64, seed);
     let erodibility = erodibility(grid, seed);
-    let (eroded, report) = evolve(grid, &land, &uplift, &erodibility, seed);
+    let diffusivity = planet.network_diffusivity as f64;
+    let (eroded, report) = evolve(grid, &land, &uplift, &erodibility, diffusivity, seed);
     let peak = quantile(
         (0..grid.len()).filter(|&k| land[k]).map(|k| eroded[k]),
         PEAK_QUANTILE,
@@ -148,13 +158,15 @@ fn erodibility(grid: &SphereGrid, seed: u64) -> Vec<f64> {
         .collect()
 }
 
-/// Runs the stream-power law from a slightly rough plain to near its steady state. Sea nodes are the base level
-/// (height 0); heights are in model units.
+/// Runs the stream-power law from a slightly rough plain to near its steady state, with hillslope diffusion of
+/// `diffusivity` (unit-sphere area per model time) over the first [`NETWORK_FORMING_TIME`]. Sea nodes are the
+/// base level (height 0); heights are in model units.
 fn evolve(
     grid: &SphereGrid,
     land: &[bool],
     uplift: &[f64],
     erodibility: &[f64],
+    diffusivity: f64,
     seed: u64,
 ) -> (Vec<f64>, ErosionReport) {
     let start_seed = rng::hash(seed, &[STREAM_START]);
@@ -170,6 +182,7 @@ fn evolve(
         })
         .collect();
     let mut dt = FIRST_STEP;
+    let mut time = 0.0;
     let mut report = ErosionReport::default();
     for step in 0..STEPS {
         let tree = ReceiverTree::new(grid, land, &h);
@@ -188,6 +201,10 @@ fn evolve(
             change = change.max((new - h[k]).abs());
             h[k] = new;
         }
+        if time < NETWORK_FORMING_TIME && diffusivity > 0.0 {
+            h = diffuse(grid, land, h, diffusivity, dt);
+        }
+        time += dt;
         let highest = h.iter().copied().fold(0.0, f64::max).max(1e-12);
         report = ErosionReport {
             steps: step + 1,
@@ -196,6 +213,38 @@ fn evolve(
         dt = (dt * STEP_GROWTH).min(LONGEST_STEP);
     }
     (h, report)
+}
+
+/// `h` after `dt` of linear diffusion `D lap h` on land (the sea stays the base level), in explicit substeps
+/// small enough to be stable. The Laplacian weighs each neighbour by one over its squared angle.
+fn diffuse(grid: &SphereGrid, land: &[bool], mut h: Vec<f64>, d: f64, dt: f64) -> Vec<f64> {
+    let stiffest = (0..grid.len() as u32)
+        .into_par_iter()
+        .map(|k| {
+            grid.steps(k)
+                .map(|(_, angle)| 1.0 / (angle * angle))
+                .sum::<f64>()
+        })
+        .reduce(|| 0.0, f64::max);
+    let substeps = (dt * d * stiffest / DIFFUSION_STABILITY).ceil().max(1.0);
+    let step = dt / substeps;
+    for _ in 0..substeps as usize {
+        h = (0..grid.len() as u32)
+            .into_par_iter()
+            .map(|k| {
+                let here = h[k as usize];
+                if !land[k as usize] {
+                    return here;
+                }
+                let laplacian: f64 = grid
+                    .steps(k)
+                    .map(|(next, angle)| (h[next as usize] - here) / (angle * angle))
+                    .sum();
+                here + step * d * laplacian
+            })
+            .collect();
+    }
+    h
 }
 
 /// Where the water of each land node goes in one step of the evolution (Braun and Willett 2013): its steepest
@@ -283,4 +332,34 @@ fn quantile(values: impl Iterator<Item = f64>, q: f64) -> f64 {
     }
     let i = ((v.len() - 1) as f64 * q).round() as usize;
     *v.select_nth_unstable_by(i, f64::total_cmp).1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Diffusion over a step far beyond the explicit limit stays bounded by the heights it starts from (the
+    /// maximum principle, which an unstable step breaks at once), smooths them, and leaves the sea at its level.
+    #[test]
+    fn diffusion_is_stable_smoothing_and_keeps_the_sea() {
+        let grid = SphereGrid::new(&FaceLattice::new(16, 0.0));
+        let land: Vec<bool> = grid.directions.iter().map(|d| d.z > -0.3).collect();
+        let h: Vec<f64> = (0..grid.len())
+            .map(|k| match land[k] {
+                true => (rng::hash(7, &[k as u64]) >> 11) as f64 / (1u64 << 53) as f64,
+                false => 0.0,
+            })
+            .collect();
+        let roughness = |h: &[f64]| -> f64 {
+            (0..grid.len() as u32)
+                .filter(|&k| land[k as usize])
+                .flat_map(|k| grid.steps(k).map(move |(n, _)| (k, n)))
+                .map(|(k, n)| (h[k as usize] - h[n as usize]).abs())
+                .sum()
+        };
+        let after = diffuse(&grid, &land, h.clone(), 1e-3, 50.0);
+        assert!(after.iter().all(|&x| (0.0..=1.0).contains(&x)));
+        assert!((0..grid.len()).all(|k| land[k] || after[k] == 0.0));
+        assert!(roughness(&after) < 0.2 * roughness(&h));
+    }
 }
