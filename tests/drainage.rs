@@ -184,7 +184,9 @@ fn assert_flows_downhill_and_never_crosses(d: &Drainage, what: &str) {
         if let Some(next) = reach.downstream {
             assert!(
                 d.reaches[next].beds[0] <= *reach.beds.last().unwrap(),
-                "{what}"
+                "{what}: reach {next} begins at {} above the end of the reach flowing into it, {}",
+                d.reaches[next].beds[0],
+                reach.beds.last().unwrap()
             );
         }
     }

@@ -86,8 +86,9 @@ pub fn meander(reach: &ReachPath, scale: &MeanderScale, width: &impl Fn(f64) -> 
             (at + across * y * squeeze).normalize()
         })
         .collect();
-    // Beds and areas by the position along the valley, between the lattice nodes around it.
-    let (beds, areas) = course
+    // Beds and areas by the position along the valley, between the lattice nodes around it; the ends exactly the
+    // reach's, as its end points are (an interpolated last bed a rounding below it would rise into the next reach).
+    let (mut beds, areas): (Vec<f32>, Vec<f64>) = course
         .iter()
         .map(|&(x, _)| {
             let (i, t) = valley.node_at(x);
@@ -96,6 +97,8 @@ pub fn meander(reach: &ReachPath, scale: &MeanderScale, width: &impl Fn(f64) -> 
             (bed, reach.areas[i] + (reach.areas[j] - reach.areas[i]) * t)
         })
         .unzip();
+    let last = beds.len() - 1;
+    (beds[0], beds[last]) = (reach.beds[0], reach.beds[reach.beds.len() - 1]);
     ReachPath {
         points,
         beds: monotone(beds),
@@ -366,6 +369,7 @@ mod tests {
         assert!(belt <= 0.25 * scale().cell * 1.01, "{belt}");
         assert!(m.beds.windows(2).all(|w| w[1] <= w[0]));
         assert_eq!(m.beds[0], reach.beds[0]);
+        assert_eq!(m.beds.last(), reach.beds.last());
     }
 
     #[test]
