@@ -297,6 +297,7 @@ fn generate_with_the_drainage_model_writes_its_measures_reaches_and_lakes() {
     for key in [
         "rivers",
         "confluences",
+        "multiple_junctions",
         "lakes",
         "strahler_max",
         "bifurcation_ratio",

@@ -170,6 +170,13 @@ fn assert_natural(config: &riverplanet::config::Config, seed: u32) {
     );
     assert!(m.drained_land_fraction >= 0.6, "seed {seed}: {m:?}");
     assert!(m.confluences > 100 && m.rivers > 10);
+    // D8 lets three rivers or more meet at one node; most junctions stay binary, as real ones are.
+    assert!(
+        m.multiple_junctions > 0 && 4 * m.multiple_junctions <= m.confluences,
+        "seed {seed}: {} of {} confluences join three rivers or more",
+        m.multiple_junctions,
+        m.confluences
+    );
     assert_flows_downhill_and_never_crosses(d, &format!("seed {seed}"));
 }
 

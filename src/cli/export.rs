@@ -268,10 +268,11 @@ fn export_rivers(planet: super::PlanetArgs, level: Option<u32>, out: &Path) -> a
             .ok_or_else(|| anyhow::anyhow!("{source}: the drainage model made no network"))?;
         let m = &network.measures;
         println!(
-            "level {level}: {} reaches, {} confluences, {} lakes, Strahler order {}, bifurcation ratio {:.2}, \
-             Hack exponent {:.3}, {} uphill steps, {} crossings",
+            "level {level}: {} reaches, {} confluences ({} of three rivers or more), {} lakes, Strahler order {}, \
+             bifurcation ratio {:.2}, Hack exponent {:.3}, {} uphill steps, {} crossings",
             m.reaches,
             m.confluences,
+            m.multiple_junctions,
             m.lakes,
             m.strahler_max,
             m.bifurcation_ratio,

@@ -37,6 +37,9 @@ pub struct DrainageMeasures {
     pub rivers: usize,
     pub reaches: usize,
     pub confluences: usize,
+    /// Confluences where three rivers or more meet (D8 lets up to seven drain into one node; real junctions are
+    /// binary): wide rivers meeting at one point are drawn as one blob of water (docs/geomorphology.md).
+    pub multiple_junctions: usize,
     pub lakes: usize,
     pub strahler_max: u32,
     /// Strahler streams of each order (index 0: order 1) in the basins of order [`HORTON_BASIN_ORDER`] and more.
@@ -148,6 +151,11 @@ pub fn extract(
                 .iter()
                 .zip(&river)
                 .filter(|(&d, &r)| r && d >= 2)
+                .count(),
+            multiple_junctions: donors
+                .iter()
+                .zip(&river)
+                .filter(|(&d, &r)| r && d >= 3)
                 .count(),
             ..measures
         },
@@ -307,6 +315,7 @@ fn measure(
         rivers: reaches.iter().filter(|r| r.downstream.is_none()).count(),
         reaches: reaches.len(),
         confluences: 0,
+        multiple_junctions: 0,
         lakes: 0,
         strahler_max: ordering.strahler_max,
         streams_per_order: ordering.streams_per_order.clone(),
