@@ -94,17 +94,16 @@ impl HeightRefiner {
     }
 
     /// Records the refinement of `jobs`, sorted by level, each child's parent resident or earlier in the list:
-    /// one dispatch per level (a workgroup per patch), each declaring the parents' textures it samples
-    /// (`parent_texture` of a parent's slot), so that a child reads its parent's finished heights, uploaded or
-    /// refined a level before. The children's textures must be in GENERAL, bound at their slots; the caller
-    /// declares the results' next use. Returns where each child's height range arrives (read it once the
-    /// submission has completed), or `None` without jobs.
-    pub fn record<'a>(
+    /// one dispatch per level (a workgroup per patch), with a barrier between levels so that a child reads its
+    /// parent's finished heights. The children's textures must be in GENERAL, bound at their slots; the caller
+    /// makes the results visible to whatever reads them next. Returns where each child's height range arrives
+    /// (read it once the submission has completed), or `None` without jobs.
+    pub fn record(
         &self,
         rec: &mut Recorder,
-        (bindless, planet): (&Bindless, &Planet),
+        bindless: &Bindless,
+        planet: &Planet,
         jobs: &[RefineJob],
-        parent_texture: impl Fn(Slot) -> Option<&'a Image>,
     ) -> Result<Option<RefinedRanges>, GpuError> {
         if jobs.is_empty() {
             return Ok(None);
@@ -152,15 +151,9 @@ impl HeightRefiner {
                     .iter()
                     .take_while(|j| j.patch.level == level)
                     .count();
-            let parents = jobs[start..end]
-                .iter()
-                .map(|j| {
-                    parent_texture(j.parent_slot).ok_or_else(|| {
-                        GpuError::Invalid(format!("no texture for the parent of {:?}", j.patch))
-                    })
-                })
-                .collect::<Result<Vec<&Image>, GpuError>>()?;
-            rec.use_images(&parents, &[Access::ComputeSampled]);
+            if start > 0 {
+                rec.memory_barrier(&[Access::ComputeWrite], &[Access::ComputeSampled]);
+            }
             let mut buffer = rec.ctx().create_buffer(&BufferDesc {
                 name: "height refinement jobs",
                 size: ((end - start) * row) as u64,
@@ -309,11 +302,6 @@ pub fn generate_on_gpu(
         }
     };
     let bindless_ref = &*bindless;
-    let slot_images: HashMap<Slot, &Image> = all
-        .iter()
-        .zip(&images)
-        .map(|(p, image)| (slots[p], image))
-        .collect();
     let result = ctx.run_and_wait("height refinement", |rec| {
         let refs: Vec<&Image> = images.iter().collect();
         prepare_height_textures(rec, &refs);
@@ -331,8 +319,8 @@ pub fn generate_on_gpu(
                 });
             }
         }
-        let texture = |slot: Slot| slot_images.get(&slot).copied();
-        let ranges = refiner.record(rec, (bindless_ref, planet), &jobs, texture)?;
+        rec.memory_barrier(&[Access::TransferWrite], &[Access::ComputeSampled]);
+        let ranges = refiner.record(rec, bindless_ref, planet, &jobs)?;
         let wanted: Vec<&Image> = patches
             .iter()
             .map(|p| {
