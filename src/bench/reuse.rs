@@ -154,12 +154,8 @@ pub fn reuse_bench(
         .iter()
         .map(|(_, _, k, q)| Some((parent_out.slots()[*k], *q)))
         .collect();
-    let inherited = parent_out.parent_textures(&inherit);
     let mut gpu = |variant, from_parent: bool| -> Result<f64, GpuError> {
-        let parents = match from_parent {
-            true => (&inherit[..], &inherited[..]),
-            false => (&[][..], &[][..]),
-        };
+        let parents = if from_parent { &inherit[..] } else { &[] };
         let run = || {
             run_batch_into(
                 ctx,
@@ -187,7 +183,7 @@ pub fn reuse_bench(
         &kernel,
         KernelVariant::Tiled,
         &parent_jobs,
-        (&[], &[]),
+        &[],
         &params,
         &parent_out,
     )

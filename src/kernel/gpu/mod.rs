@@ -48,8 +48,6 @@ pub struct KernelBatch<'a> {
     pub slots: &'a [Slot],
     pub jobs: &'a [PatchJob<'a>],
     pub parents: &'a [Option<(Slot, ParentQuadrant)>],
-    /// The river textures those parents' slots hold (each once): the dispatch reads them.
-    pub parent_textures: &'a [&'a Image],
 }
 
 /// Both kernel pipelines, ready to record dispatches.
@@ -147,8 +145,10 @@ impl RiverKernel {
         if batch.jobs.is_empty() {
             return Ok(0);
         }
-        // The parents' river textures were written by an earlier dispatch.
-        rec.use_images(batch.parent_textures, &[Access::ComputeRead]);
+        if batch.parents.iter().any(Option::is_some) {
+            // The parents' river textures were written by an earlier dispatch.
+            rec.memory_barrier(&[Access::ComputeWrite], &[Access::ComputeRead]);
+        }
         let ctx = rec.ctx();
         let host_buffer = |name: &str, size: usize| {
             ctx.create_buffer(&BufferDesc {
