@@ -122,7 +122,7 @@ fn reuse_against_scratch(world: &World, parent: PatchId) -> (f32, f32) {
     let kernel = RiverKernel::new(ctx, &bindless, n, KernelTuning::for_device(ctx)).unwrap();
     let parent_out = BatchOutputs::new(ctx, &mut bindless, 1, n).unwrap();
     let child_out = BatchOutputs::new(ctx, &mut bindless, 4, n).unwrap();
-    let run = |variant, jobs: &[PatchJob], parents: &[_], outputs: &BatchOutputs| {
+    let run = |variant, jobs: &[PatchJob], parents, outputs: &BatchOutputs| {
         run_batch_into(
             ctx, &bindless, &kernel, variant, jobs, parents, &params, outputs,
         )
@@ -130,9 +130,16 @@ fn reuse_against_scratch(world: &World, parent: PatchId) -> (f32, f32) {
     };
     let parent_slot = parent_out.slots()[0];
     let parents: Vec<_> = quadrants.iter().map(|q| Some((parent_slot, *q))).collect();
+    let parent_textures = parent_out.parent_textures(&parents);
     for variant in [KernelVariant::Simple, KernelVariant::Tiled] {
-        let parent_gpu = run(variant, &parent_jobs, &[], &parent_out).texels;
-        let reused = run(variant, &child_jobs, &parents, &child_out).texels;
+        let parent_gpu = run(variant, &parent_jobs, (&[], &[]), &parent_out).texels;
+        let reused = run(
+            variant,
+            &child_jobs,
+            (&parents, &parent_textures),
+            &child_out,
+        )
+        .texels;
         diff = diff.max(max_abs_diff(&scratch, &reused));
         // The even vertices are the parent's GPU values, copied.
         for (texels, q) in reused.iter().zip(&quadrants) {

@@ -232,7 +232,7 @@ impl VariantRunner {
                     &self.kernel,
                     variant,
                     jobs,
-                    &[],
+                    (&[], &[]),
                     params,
                     outputs,
                 )

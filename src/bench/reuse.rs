@@ -154,8 +154,12 @@ pub fn reuse_bench(
         .iter()
         .map(|(_, _, k, q)| Some((parent_out.slots()[*k], *q)))
         .collect();
+    let inherited = parent_out.parent_textures(&inherit);
     let mut gpu = |variant, from_parent: bool| -> Result<f64, GpuError> {
-        let parents = if from_parent { &inherit[..] } else { &[] };
+        let parents = match from_parent {
+            true => (&inherit[..], &inherited[..]),
+            false => (&[][..], &[][..]),
+        };
         let run = || {
             run_batch_into(
                 ctx,
@@ -183,7 +187,7 @@ pub fn reuse_bench(
         &kernel,
         KernelVariant::Tiled,
         &parent_jobs,
-        &[],
+        (&[], &[]),
         &params,
         &parent_out,
     )

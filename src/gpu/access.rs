@@ -152,17 +152,30 @@ pub(crate) fn image_usage(uses: &[Access]) -> vk::ImageUsageFlags {
 /// The stages and accesses of one side of a barrier. Only writes need to be made available, so the source side
 /// keeps the write accesses alone (reads before a barrier need just the execution dependency).
 fn side(accesses: &[Access], source: bool) -> (vk::PipelineStageFlags2, vk::AccessFlags2) {
-    let writes = vk::AccessFlags2::TRANSFER_WRITE
-        | vk::AccessFlags2::SHADER_STORAGE_WRITE
-        | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
-        | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE;
     accesses.iter().fold(
         (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
         |(stages, access), a| {
             let (s, m) = a.masks();
-            (stages | s, access | if source { m & writes } else { m })
+            (stages | s, access | if source { m & WRITES } else { m })
         },
     )
+}
+
+/// The accesses that write.
+const WRITES: vk::AccessFlags2 = vk::AccessFlags2::from_raw(
+    vk::AccessFlags2::TRANSFER_WRITE.as_raw()
+        | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw()
+        | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE.as_raw()
+        | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+);
+
+/// Whether every one of `accesses` reads a resource's contents and none writes them: reads like these may run
+/// together, as a render graph's read-only uses combine.
+pub(crate) fn reads_only(accesses: &[Access]) -> bool {
+    !accesses.is_empty()
+        && accesses.iter().all(|&a| {
+            !matches!(a, Access::Nothing | Access::Present) && (a.masks().1 & WRITES).is_empty()
+        })
 }
 
 /// A memory barrier between the uses `before` and the uses `after` of any resource.

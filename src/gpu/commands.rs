@@ -157,7 +157,7 @@ impl Recorder<'_> {
     fn transition_images(&mut self, images: &[&Image], uses: &[Access], discard: bool) {
         let barriers: Vec<_> = images
             .iter()
-            .map(|image| {
+            .filter_map(|image| {
                 transition(
                     image.raw,
                     image.range(),
@@ -199,8 +199,9 @@ impl Recorder<'_> {
             .aspect_mask(aspect)
             .level_count(1)
             .layer_count(1);
-        let barrier = [transition(image, range, false, state, uses, discard)];
-        self.pipeline_barrier(&vk::DependencyInfo::default().image_memory_barriers(&barrier));
+        if let Some(barrier) = transition(image, range, false, state, uses, discard) {
+            self.pipeline_barrier(&vk::DependencyInfo::default().image_memory_barriers(&[barrier]));
+        }
     }
 
     fn pipeline_barrier(&mut self, dependency: &vk::DependencyInfo) {
@@ -420,7 +421,10 @@ fn whole_layers(image: &Image, first: u32, count: u32, offset: u64) -> vk::Buffe
         })
 }
 
-/// The barrier of `image` from the uses `state` last recorded to `uses`, which it records.
+/// The barrier of `image` from the uses `state` last recorded to `uses`, which it records. Reads after reads in
+/// one layout join the reads recorded, as a render graph's read-only uses combine: no barrier where they were
+/// recorded already, else one that makes the last write visible to the new reads too (the barrier before the
+/// first reads made it available; this one chains after them).
 fn transition(
     image: vk::Image,
     range: vk::ImageSubresourceRange,
@@ -428,9 +432,34 @@ fn transition(
     state: &UseState,
     uses: &[Access],
     discard: bool,
-) -> vk::ImageMemoryBarrier2<'static> {
+) -> Option<vk::ImageMemoryBarrier2<'static>> {
+    let recorded = state.get();
+    let layout = |accesses: &[Access]| accesses.first().map(|a| a.layout(shader_visible));
+    let same_layout = layout(&recorded) == layout(uses);
+    if !discard && same_layout && access::reads_only(&recorded) && access::reads_only(uses) {
+        let new: Vec<Access> = uses
+            .iter()
+            .copied()
+            .filter(|a| !recorded.contains(a))
+            .collect();
+        if new.is_empty() {
+            return None;
+        }
+        let joined: Vec<Access> = recorded.iter().chain(&new).copied().collect();
+        state.replace(&joined);
+        return Some(access::image_barrier(
+            image,
+            range,
+            shader_visible,
+            &ImageUse {
+                before: &recorded,
+                after: &new,
+                discard,
+            },
+        ));
+    }
     let before = state.replace(uses);
-    access::image_barrier(
+    Some(access::image_barrier(
         image,
         range,
         shader_visible,
@@ -439,5 +468,50 @@ fn transition(
             after: uses,
             discard,
         },
-    )
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Reads after reads join the reads recorded: a barrier only for a read not recorded yet (which must see the
+    /// last write), none for one recorded; the next write waits for every read joined.
+    #[test]
+    fn reads_join_and_the_next_write_waits_for_all_of_them() {
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(vk::ImageAspectFlags::COLOR)
+            .level_count(1)
+            .layer_count(1);
+        let state = UseState::fresh();
+        let next = |uses: &[Access], discard: bool| {
+            transition(vk::Image::null(), range, true, &state, uses, discard)
+        };
+        assert!(next(&[Access::ComputeWrite], true).is_some());
+        let drawn = [Access::GraphicsSampled, Access::ComputeSampled];
+        let to_draw = next(&drawn, false).expect("the write is made visible");
+        assert_eq!(
+            to_draw.src_access_mask,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE
+        );
+        let loaded = next(&[Access::ComputeRead], false).expect("a new kind of read");
+        assert_eq!(loaded.src_access_mask, vk::AccessFlags2::NONE);
+        assert_eq!(
+            loaded.dst_access_mask,
+            vk::AccessFlags2::SHADER_STORAGE_READ
+        );
+        assert!(next(&[Access::ComputeSampled], false).is_none());
+        assert_eq!(
+            state.get(),
+            vec![
+                Access::GraphicsSampled,
+                Access::ComputeSampled,
+                Access::ComputeRead
+            ]
+        );
+        let rewrite = next(&[Access::ComputeWrite], false).expect("a write after reads");
+        assert!(rewrite.src_stage_mask.contains(
+            vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER
+        ));
+    }
 }

@@ -18,6 +18,11 @@ impl UseState {
         Arc::new(Self(Mutex::new(vec![Access::Nothing])))
     }
 
+    /// The uses last recorded.
+    pub(crate) fn get(&self) -> Vec<Access> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
     /// Records `next` as the image's uses and returns the ones it had.
     pub(crate) fn replace(&self, next: &[Access]) -> Vec<Access> {
         let mut uses = self.0.lock().unwrap_or_else(|e| e.into_inner());

@@ -46,6 +46,11 @@ impl<D> PatchCache<D> {
         })
     }
 
+    /// The data of a resident patch, without marking it used.
+    pub fn peek(&self, patch: &PatchId) -> Option<&D> {
+        self.entries.get(patch).map(|e| &e.data)
+    }
+
     /// The data of a resident patch to change, without marking it used.
     pub fn get_mut(&mut self, patch: &PatchId) -> Option<&mut D> {
         self.entries.get_mut(patch).map(|e| &mut e.data)

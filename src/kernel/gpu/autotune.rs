@@ -143,7 +143,7 @@ pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
                 &kernel,
                 variant,
                 &jobs,
-                &[],
+                (&[], &[]),
                 &params,
                 &outputs,
             );

@@ -95,6 +95,17 @@ impl BatchOutputs {
         &self.slots
     }
 
+    /// The textures that `parents` (as in [`KernelBatch`]) name by their slots, each once: what a batch reading
+    /// these outputs as its parents declares it reads.
+    pub fn parent_textures(&self, parents: &[Option<(Slot, ParentQuadrant)>]) -> Vec<&Image> {
+        self.images
+            .iter()
+            .zip(&self.slots)
+            .filter(|(_, slot)| parents.iter().flatten().any(|(s, _)| s == *slot))
+            .map(|(image, _)| image)
+            .collect()
+    }
+
     /// Bytes of one patch's two layers, tightly packed.
     fn texel_bytes(grid_size: u32) -> u64 {
         (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
@@ -120,13 +131,26 @@ pub fn run_batch(
     params: &KernelParams,
 ) -> Result<BatchResult, GpuError> {
     let outputs = BatchOutputs::new(ctx, bindless, jobs.len(), kernel.grid_size)?;
-    let result = run_batch_into(ctx, bindless, kernel, variant, jobs, &[], params, &outputs);
+    let result = run_batch_into(
+        ctx,
+        bindless,
+        kernel,
+        variant,
+        jobs,
+        (&[], &[]),
+        params,
+        &outputs,
+    );
     outputs.release(ctx, bindless);
     result
 }
 
+/// Where a batch's patches take their parents' river data: per job, the parent's slot and quadrant, and the
+/// textures those slots hold (as in [`KernelBatch`]).
+pub type Parents<'a> = (&'a [Option<(Slot, ParentQuadrant)>], &'a [&'a Image]);
+
 /// [`run_batch`] into existing outputs (at least one texture per job): upload, dispatch, readback, decode.
-/// `parents` as in [`KernelBatch`].
+/// `parents` and the textures they name as in [`KernelBatch`] ([`BatchOutputs::parent_textures`]).
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch_into(
     ctx: &Context,
@@ -134,7 +158,7 @@ pub fn run_batch_into(
     kernel: &RiverKernel,
     variant: KernelVariant,
     jobs: &[PatchJob],
-    parents: &[Option<(Slot, ParentQuadrant)>],
+    (parents, parent_textures): Parents,
     params: &KernelParams,
     outputs: &BatchOutputs,
 ) -> Result<BatchResult, GpuError> {
@@ -160,6 +184,7 @@ pub fn run_batch_into(
             slots,
             jobs,
             parents,
+            parent_textures,
         };
         let bytes = profiler.scope(rec, "kernel", |rec| {
             kernel.record(rec, bindless, variant, &batch, params)

@@ -48,6 +48,8 @@ pub struct KernelBatch<'a> {
     pub slots: &'a [Slot],
     pub jobs: &'a [PatchJob<'a>],
     pub parents: &'a [Option<(Slot, ParentQuadrant)>],
+    /// The river textures those parents' slots hold (each once): the dispatch reads them.
+    pub parent_textures: &'a [&'a Image],
 }
 
 /// Both kernel pipelines, ready to record dispatches.
@@ -145,10 +147,8 @@ impl RiverKernel {
         if batch.jobs.is_empty() {
             return Ok(0);
         }
-        if batch.parents.iter().any(Option::is_some) {
-            // The parents' river textures were written by an earlier dispatch.
-            rec.memory_barrier(&[Access::ComputeWrite], &[Access::ComputeRead]);
-        }
+        // The parents' river textures were written by an earlier dispatch.
+        rec.use_images(batch.parent_textures, &[Access::ComputeRead]);
         let ctx = rec.ctx();
         let host_buffer = |name: &str, size: usize| {
             ctx.create_buffer(&BufferDesc {

@@ -339,7 +339,8 @@ impl Renderer<'_> {
         let push = bytemuck::bytes_of(&push);
         let cache = &self.vertex_cache;
         self.frames.profiler().scope(rec, "vertices", |rec| {
-            cache.record(rec, (&sets, push), &vertex_cache, cached, n, water_pass)
+            let water = water_draws.as_ref().zip(water_indices.as_ref());
+            cache.record(rec, (&sets, push), &vertex_cache, cached, n, water)
         })?;
         if let (Some(sky), Some(vertices)) = (&self.sky, &dome_vertices) {
             self.frames.profiler().scope(rec, "sky dome", |rec| {

@@ -133,8 +133,8 @@ impl Renderer<'_> {
         }
         // Read by the terrain's shaders, and by the vertex cache's compute pass before them (draw.rs): without the
         // compute stage here, a GPU could compute a new patch's vertices before its heights were written.
-        rec.memory_barrier(
-            &[Access::ComputeWrite, Access::TransferWrite],
+        rec.use_images(
+            &base_refs,
             &[Access::GraphicsSampled, Access::ComputeSampled],
         );
 
@@ -164,11 +164,25 @@ impl Renderer<'_> {
         }
         if !rivers.is_empty() {
             let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
+            // The resident parents' river textures (made in earlier frames), each once.
+            let mut parent_patches: Vec<PatchId> = prepared
+                .iter()
+                .zip(&river_of)
+                .filter(|(_, river)| river.is_some_and(|k| parents[k].is_some()))
+                .filter_map(|(p, _)| p.patch.parent())
+                .collect();
+            parent_patches.sort_unstable();
+            parent_patches.dedup();
+            let parent_textures: Vec<&Image> = parent_patches
+                .iter()
+                .filter_map(|q| self.cache.peek(q)?.river.as_ref().map(|(image, _)| image))
+                .collect();
             let batch = KernelBatch {
                 textures: &textures,
                 slots: &slots,
                 jobs: &patch_jobs,
                 parents: &parents,
+                parent_textures: &parent_textures,
             };
             let (kernel, bindless, variant, params) =
                 (&self.kernel, &self.bindless, self.variant, &self.params);

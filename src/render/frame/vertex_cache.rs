@@ -106,7 +106,7 @@ impl VertexCache {
         })
     }
 
-    /// Records the passes that fill `cache`, then, for a frame with a `water_pass`, the water indices and draws
+    /// Records the passes that fill `cache`, then, for a frame with the water pass, its `water` draws and indices
     /// from it (all bound in `sets`), for instances 0 .. `patches`, and makes them visible to the vertex shaders and
     /// the indexed indirect draws.
     pub(super) fn record(
@@ -116,7 +116,7 @@ impl VertexCache {
         cache: &Buffer,
         patches: usize,
         n: u32,
-        water_pass: bool,
+        water: Option<(&Buffer, &Buffer)>,
     ) {
         if patches == 0 {
             return;
@@ -129,15 +129,15 @@ impl VertexCache {
             [(n * n).div_ceil(WORKGROUP), patches as u32, 1],
         );
         rec.use_buffer(cache, &[Access::ComputeRead, Access::VertexShaderRead]);
-        if !water_pass {
+        let Some((draws, indices)) = water else {
             return;
-        }
+        };
+        // The draws' instance counts are read and written (counted up), the indices written.
+        rec.use_buffer(draws, &[Access::ComputeRead, Access::ComputeWrite]);
+        rec.use_buffer(indices, &[Access::ComputeWrite]);
         rec.dispatch(&self.water_triangles, sets, push, [1, patches as u32, 1]);
-        // One barrier for the draws and their indices (lavapipe waits for all earlier work at every barrier).
-        rec.memory_barrier(
-            &[Access::ComputeRead, Access::ComputeWrite],
-            &[Access::IndirectCommands, Access::IndexRead],
-        );
+        rec.use_buffer(draws, &[Access::IndirectCommands]);
+        rec.use_buffer(indices, &[Access::IndexRead]);
     }
 }
 
