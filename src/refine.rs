@@ -94,16 +94,17 @@ impl HeightRefiner {
     }
 
     /// Records the refinement of `jobs`, sorted by level, each child's parent resident or earlier in the list:
-    /// one dispatch per level (a workgroup per patch), with a barrier between levels so that a child reads its
-    /// parent's finished heights. The children's textures must be in GENERAL, bound at their slots; the caller
-    /// makes the results visible to whatever reads them next. Returns where each child's height range arrives
-    /// (read it once the submission has completed), or `None` without jobs.
-    pub fn record(
+    /// one dispatch per level (a workgroup per patch), each declaring the parents' textures it samples
+    /// (`parent_texture` of a parent's slot), so that a child reads its parent's finished heights, uploaded or
+    /// refined a level before. The children's textures must be in GENERAL, bound at their slots; the caller
+    /// declares the results' next use. Returns where each child's height range arrives (read it once the
+    /// submission has completed), or `None` without jobs.
+    pub fn record<'a>(
         &self,
         rec: &mut Recorder,
-        bindless: &Bindless,
-        planet: &Planet,
+        (bindless, planet): (&Bindless, &Planet),
         jobs: &[RefineJob],
+        parent_texture: impl Fn(Slot) -> Option<&'a Image>,
     ) -> Result<Option<RefinedRanges>, GpuError> {
         if jobs.is_empty() {
             return Ok(None);
@@ -151,9 +152,15 @@ impl HeightRefiner {
                     .iter()
                     .take_while(|j| j.patch.level == level)
                     .count();
-            if start > 0 {
-                rec.memory_barrier(&[Access::ComputeWrite], &[Access::ComputeSampled]);
-            }
+            let parents = jobs[start..end]
+                .iter()
+                .map(|j| {
+                    parent_texture(j.parent_slot).ok_or_else(|| {
+                        GpuError::Invalid(format!("no texture for the parent of {:?}", j.patch))
+                    })
+                })
+                .collect::<Result<Vec<&Image>, GpuError>>()?;
+            rec.use_images(&parents, &[Access::ComputeSampled]);
             let mut buffer = rec.ctx().create_buffer(&BufferDesc {
                 name: "height refinement jobs",
                 size: ((end - start) * row) as u64,
@@ -302,6 +309,11 @@ pub fn generate_on_gpu(
         }
     };
     let bindless_ref = &*bindless;
+    let slot_images: HashMap<Slot, &Image> = all
+        .iter()
+        .zip(&images)
+        .map(|(p, image)| (slots[p], image))
+        .collect();
     let result = ctx.run_and_wait("height refinement", |rec| {
         let refs: Vec<&Image> = images.iter().collect();
         prepare_height_textures(rec, &refs);
@@ -319,8 +331,8 @@ pub fn generate_on_gpu(
                 });
             }
         }
-        rec.memory_barrier(&[Access::TransferWrite], &[Access::ComputeSampled]);
-        let ranges = refiner.record(rec, bindless_ref, planet, &jobs)?;
+        let texture = |slot: Slot| slot_images.get(&slot).copied();
+        let ranges = refiner.record(rec, (bindless_ref, planet), &jobs, texture)?;
         let wanted: Vec<&Image> = patches
             .iter()
             .map(|p| {

@@ -178,17 +178,6 @@ pub(crate) fn reads_only(accesses: &[Access]) -> bool {
         })
 }
 
-/// A memory barrier between the uses `before` and the uses `after` of any resource.
-pub(crate) fn memory_barrier(before: &[Access], after: &[Access]) -> vk::MemoryBarrier2<'static> {
-    let (src_stage, src_access) = side(before, true);
-    let (dst_stage, dst_access) = side(after, false);
-    vk::MemoryBarrier2::default()
-        .src_stage_mask(src_stage)
-        .src_access_mask(src_access)
-        .dst_stage_mask(dst_stage)
-        .dst_access_mask(dst_access)
-}
-
 /// A barrier of the whole of `buffer` between the uses `before` and `after`.
 pub(crate) fn buffer_barrier(
     buffer: vk::Buffer,
@@ -256,7 +245,8 @@ mod tests {
 
     #[test]
     fn a_barrier_makes_only_writes_available_and_waits_for_every_use_after() {
-        let b = memory_barrier(
+        let b = buffer_barrier(
+            vk::Buffer::null(),
             &[Access::ComputeRead, Access::ComputeWrite],
             &[Access::IndirectCommands, Access::VertexShaderRead],
         );

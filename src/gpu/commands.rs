@@ -136,13 +136,6 @@ impl Recorder<'_> {
         self.pipeline_barrier(&vk::DependencyInfo::default().buffer_memory_barriers(&barrier));
     }
 
-    /// A barrier between the uses `before` and `after` of every resource (cheaper to write than one per resource
-    /// when many patches are involved).
-    pub fn memory_barrier(&mut self, before: &[Access], after: &[Access]) {
-        let barrier = [access::memory_barrier(before, after)];
-        self.pipeline_barrier(&vk::DependencyInfo::default().memory_barriers(&barrier));
-    }
-
     /// Makes each of `images` ready for `uses`, after the uses it was last recorded for (gpu/state.rs), keeping
     /// its contents.
     pub fn use_images(&mut self, images: &[&Image], uses: &[Access]) {

@@ -121,13 +121,25 @@ impl Renderer<'_> {
             };
             made.insert(p.patch, (*slot, range));
         }
-        rec.memory_barrier(&[Access::TransferWrite], &[Access::ComputeSampled]);
         let mut bytes = 0;
         let mut ranges = None;
         if !jobs.is_empty() {
+            // The parents' textures: made in this frame, or resident from an earlier one.
+            let made_here: HashMap<Slot, &Image> = bases.iter().map(|(i, s)| (*s, i)).collect();
+            let cache = &self.cache;
+            let parent_texture = |slot: Slot| {
+                made_here.get(&slot).copied().or_else(|| {
+                    let parent = jobs
+                        .iter()
+                        .find(|j| j.parent_slot == slot)?
+                        .patch
+                        .parent()?;
+                    cache.peek(&parent).map(|data| &data.base)
+                })
+            };
             let (refiner, bindless, planet) = (&self.refiner, &self.bindless, self.planet);
             ranges = self.frames.profiler().scope(rec, "heights", |rec| {
-                refiner.record(rec, bindless, planet, &jobs)
+                refiner.record(rec, (bindless, planet), &jobs, parent_texture)
             })??;
             bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
