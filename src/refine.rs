@@ -95,7 +95,7 @@ impl HeightRefiner {
 
     /// Records the refinement of `jobs`, sorted by level, each child's parent resident or earlier in the list:
     /// one dispatch per level (a workgroup per patch), each declaring the parents' textures it samples
-    /// (`parent_texture` of a parent's slot), so that a child reads its parent's finished heights, uploaded or
+    /// (`parent_texture` of a job), so that a child reads its parent's finished heights, uploaded or
     /// refined a level before. The children's textures must be in GENERAL, bound at their slots; the caller
     /// declares the results' next use. Returns where each child's height range arrives (read it once the
     /// submission has completed), or `None` without jobs.
@@ -104,7 +104,7 @@ impl HeightRefiner {
         rec: &mut Recorder,
         (bindless, planet): (&Bindless, &Planet),
         jobs: &[RefineJob],
-        parent_texture: impl Fn(Slot) -> Option<&'a Image>,
+        parent_texture: impl Fn(&RefineJob) -> Option<&'a Image>,
     ) -> Result<Option<RefinedRanges>, GpuError> {
         if jobs.is_empty() {
             return Ok(None);
@@ -155,7 +155,7 @@ impl HeightRefiner {
             let parents = jobs[start..end]
                 .iter()
                 .map(|j| {
-                    parent_texture(j.parent_slot).ok_or_else(|| {
+                    parent_texture(j).ok_or_else(|| {
                         GpuError::Invalid(format!("no texture for the parent of {:?}", j.patch))
                     })
                 })
@@ -331,7 +331,7 @@ pub fn generate_on_gpu(
                 });
             }
         }
-        let texture = |slot: Slot| slot_images.get(&slot).copied();
+        let texture = |job: &RefineJob| slot_images.get(&job.parent_slot).copied();
         let ranges = refiner.record(rec, (bindless_ref, planet), &jobs, texture)?;
         let wanted: Vec<&Image> = patches
             .iter()

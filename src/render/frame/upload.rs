@@ -127,15 +127,11 @@ impl Renderer<'_> {
             // The parents' textures: made in this frame, or resident from an earlier one.
             let made_here: HashMap<Slot, &Image> = bases.iter().map(|(i, s)| (*s, i)).collect();
             let cache = &self.cache;
-            let parent_texture = |slot: Slot| {
-                made_here.get(&slot).copied().or_else(|| {
-                    let parent = jobs
-                        .iter()
-                        .find(|j| j.parent_slot == slot)?
-                        .patch
-                        .parent()?;
-                    cache.peek(&parent).map(|data| &data.base)
-                })
+            let parent_texture = |job: &RefineJob| {
+                made_here
+                    .get(&job.parent_slot)
+                    .copied()
+                    .or_else(|| cache.peek(&job.patch.parent()?).map(|data| &data.base))
             };
             let (refiner, bindless, planet) = (&self.refiner, &self.bindless, self.planet);
             ranges = self.frames.profiler().scope(rec, "heights", |rec| {
