@@ -33,6 +33,8 @@ layout(set = 1, binding = 1, std430) writeonly buffer Ranges { vec2 ranges[]; };
 layout(push_constant) uniform Push {
     uint seed;
     float amplitude;  // detail-amplitude: the displacement of level 0
+    float flatShare;  // DetailRule::flat_share: the displacement's share on level ground
+    float spreadGain; // DetailRule::spread_gain
 } push;
 
 shared float centres[SPAN * SPAN];
@@ -87,25 +89,31 @@ uint latticeHash(uint level, uvec3 key) {
     return mix32(h ^ (key.z + 0x9e3779b9u));
 }
 
-// The average plus the point's displacement (DetailRule::displacement), or the bare average in a corner quadrant.
-float displaced(float average, ivec2 g) {
-    if (inCornerQuadrant(g)) return average;
-    uint level = uint(job.level);
-    uint h = latticeHash(level, latticeKey(g));
-    precise float unit = float(h >> 8) * (1.0 / 16777216.0) * 2.0 - 1.0;
-    precise float amplitude = push.amplitude * uintBitsToFloat((127u - min(level, 126u)) << 23);
-    precise float value = average + unit * amplitude;
-    return value;
-}
-
-// The four values in ascending order, summed left to right.
-float sortedAverage(vec4 v) {
+// The four values in ascending order, summed left to right: their average, and the highest less the lowest.
+vec2 sortedAverageAndSpread(vec4 v) {
     float a = min(v.x, v.y), b = max(v.x, v.y), c = min(v.z, v.w), d = max(v.z, v.w);
     float s0 = min(a, c), t = max(a, c), u = min(b, d), s3 = max(b, d);
     float s1 = min(t, u), s2 = max(t, u);
     precise float sum = ((s0 + s1) + s2) + s3;
     precise float average = sum * 0.25;
-    return average;
+    precise float spread = s3 - s0;
+    return vec2(average, spread);
+}
+
+// The point between the four heights `around` (DetailRule::displaced): their average plus its displacement, the
+// level's amplitude times its share (the flat share, growing with the spread), or the bare average in a corner
+// quadrant.
+float displaced(vec4 around, ivec2 g) {
+    vec2 averageAndSpread = sortedAverageAndSpread(around);
+    if (inCornerQuadrant(g)) return averageAndSpread.x;
+    uint level = uint(job.level);
+    uint h = latticeHash(level, latticeKey(g));
+    precise float unit = float(h >> 8) * (1.0 / 16777216.0) * 2.0 - 1.0;
+    precise float amplitude = push.amplitude * uintBitsToFloat((127u - min(level, 126u)) << 23);
+    precise float levels = uintBitsToFloat((127u + min(level, 127u)) << 23);
+    precise float share = min(push.flatShare + (averageAndSpread.y * levels) * push.spreadGain, 1.0);
+    precise float value = averageAndSpread.x + unit * (amplitude * share);
+    return value;
 }
 
 // A point of the parent's lattice (even child coordinates).
@@ -133,7 +141,7 @@ void main() {
         ivec2 g = origin - REACH + 2 * ivec2(k % SPAN, k / SPAN);
         vec4 corners = vec4(parentAt(g + ivec2(-1, -1)), parentAt(g + ivec2(1, -1)), parentAt(g + ivec2(-1, 1)),
                             parentAt(g + ivec2(1, 1)));
-        centres[k] = displaced(sortedAverage(corners), g);
+        centres[k] = displaced(corners, g);
     }
     barrier();
 
@@ -150,7 +158,7 @@ void main() {
         } else {
             vec4 around = vec4(valueAt(unfoldNeighbour(g, g + ivec2(-1, 0))), valueAt(unfoldNeighbour(g, g + ivec2(1, 0))),
                                valueAt(unfoldNeighbour(g, g + ivec2(0, -1))), valueAt(unfoldNeighbour(g, g + ivec2(0, 1))));
-            value = displaced(sortedAverage(around), g);
+            value = displaced(around, g);
         }
         imageStore(heightImages[nonuniformEXT(job.childSlot)], ivec3(texel, 0), vec4(value));
         range = vec2(min(range.x, value), max(range.y, value));

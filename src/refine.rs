@@ -129,6 +129,8 @@ impl HeightRefiner {
         let push = RefinePush {
             seed: planet.rule.seed,
             amplitude: planet.rule.amplitude,
+            flat_share: planet.rule.flat_share,
+            spread_gain: planet.rule.spread_gain,
         };
         let push = bytemuck::bytes_of(&push);
         let row = std::mem::size_of::<GpuRefineJob>();

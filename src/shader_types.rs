@@ -124,9 +124,13 @@ pub struct RefinePush {
     pub seed: u32,
     /// detail-amplitude: the displacement of level 0.
     pub amplitude: f32,
+    /// flat-detail: the displacement's share on level ground (`DetailRule::flat_share`).
+    pub flat_share: f32,
+    /// `DetailRule::spread_gain`.
+    pub spread_gain: f32,
 }
 
-const _: () = assert!(size_of::<RefinePush>() == 8);
+const _: () = assert!(size_of::<RefinePush>() == 16);
 
 /// The push constants of every pass of a frame (`FramePush` in glsl/terrain_common.glsl, whose comments say
 /// what each component holds); 128 bytes, what every Vulkan device holds.

@@ -186,6 +186,24 @@ fn the_interior_rise_lies_between_0_and_20() {
 }
 
 #[test]
+fn the_flat_detail_is_a_share_between_0_and_1() {
+    for bad in ["-0.1", "1.5", "nan"] {
+        let msg = error_of(&with("planet-attributes", "flat-detail", bad));
+        assert!(
+            msg.contains("<flat-detail>") && msg.contains("[0, 1]"),
+            "{msg}"
+        );
+    }
+    // Not yet the default (docs/planet.md, "Detail that follows the slope").
+    assert_eq!(
+        Config::defaults_for(RiverModel::Drainage)
+            .planet
+            .flat_detail,
+        1.0
+    );
+}
+
+#[test]
 fn the_network_diffusivity_lies_between_0_and_a_thousandth() {
     for bad in ["-1e-4", "0.002", "nan"] {
         let msg = error_of(&with("planet-attributes", "network-diffusivity", bad));

@@ -63,6 +63,9 @@ pub struct PlanetConfig {
     pub coast_perturbation: f32,
     /// Diamond-square displacement at level 0, in height units; halves each level (3.6).
     pub detail_amplitude: f32,
+    /// The share of that displacement on level ground, growing to all of it on slopes (beyond the thesis,
+    /// `planet::detail::DetailRule`); 1: the thesis's displacement everywhere.
+    pub flat_detail: f32,
     /// Cells per face edge of the coarsest heightmap on which continents are built: 2^n+1.
     pub base_resolution: u32,
     /// How the relief is made (the thesis's square mountains, or the drainage model's carved or eroded relief).
@@ -245,7 +248,8 @@ impl Config {
     /// values config/planet.xml was tuned with (docs/rivers.md): a river where 700
     /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), at most four
     /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples), and the
-    /// screen-space-error level of detail (docs/rendering.md; the thesis's model keeps the thesis's Eq. 6.1).
+    /// screen-space-error level of detail (docs/rendering.md; the
+    /// thesis's model keeps the thesis's Eq. 6.1).
     pub fn defaults_for(model: RiverModel) -> Self {
         let mut d = Self::appendix_a();
         d.river.model = model;
@@ -280,6 +284,7 @@ impl Config {
                 ocean_height: -4.0,
                 coast_perturbation: 3.0,
                 detail_amplitude: 8.0,
+                flat_detail: 1.0,
                 base_resolution: 129,
                 relief_model: ReliefModel::Thesis,
                 interior_rise: 0.0,

@@ -124,6 +124,9 @@ const PLANET: &[Param<PlanetConfig>] = &[
     Param::Number("detail-amplitude", Range::NonNegative, |c| {
         &mut c.detail_amplitude
     }),
+    Param::Number("flat-detail", Range::Closed(0.0, 1.0), |c| {
+        &mut c.flat_detail
+    }),
     Param::Grid("base-resolution", 9, 1025, |c| &mut c.base_resolution),
     Param::Choice("relief-model", |c, text| choose(text, &mut c.relief_model)),
     Param::Number("interior-rise", Range::Closed(0.0, 20.0), |c| {

@@ -45,27 +45,62 @@ pub fn lattice_hash(seed: u32, level: u32, key: [u32; 3]) -> u32 {
         })
 }
 
-/// The diamond-square rule at every level: seed and the displacement amplitude of level 0.
+/// The diamond-square rule at every level: seed, the displacement amplitude of level 0, and how the displacement
+/// follows the ground's slope.
 #[derive(Clone, Copy, Debug)]
 pub struct DetailRule {
     pub seed: u32,
     /// `detail-amplitude`: the displacement of points created at level 0; level L gets `2^-L` of it.
     pub amplitude: f32,
+    /// `flat-detail`: the share of the displacement a point gets where its four neighbours lie level; 1 (the
+    /// thesis, 3.6) gives every point all of it.
+    pub flat_share: f32,
+    /// How fast the share grows with the neighbours' spread: `(1 - flat_share) / (STEEP_SPREAD x amplitude)`,
+    /// rounded once here so that the shader multiplies by the same f32.
+    pub spread_gain: f32,
 }
 
+/// The spread of a point's four neighbours (highest less lowest), in amplitudes of its level, from which it gets
+/// the whole displacement. Slopes and amplitudes both halve per level, so this is a slope: on the default planet
+/// (base cells 12.6 units, amplitude 2) about 0.08, a valley side; a floodplain falls 0.003.
+pub const STEEP_SPREAD: f32 = 4.0;
+
 impl DetailRule {
+    /// The rule of `seed` with displacement `amplitude` at level 0, `flat_share` of it on level ground.
+    pub fn new(seed: u32, amplitude: f32, flat_share: f32) -> Self {
+        let spread_gain = if amplitude > 0.0 {
+            (1.0 - flat_share) / (STEEP_SPREAD * amplitude)
+        } else {
+            0.0
+        };
+        Self {
+            seed,
+            amplitude,
+            flat_share,
+            spread_gain,
+        }
+    }
+
     /// The displacement amplitude of points created at `level`: a multiplication by the exact f32 of 2^-level
     /// (built from its bits, as the shader does), so CPU and GPU agree.
     pub fn amplitude_at(&self, level: u32) -> f32 {
         self.amplitude * f32::from_bits((127 - level.min(126)) << 23)
     }
 
-    /// The random displacement of the point created at `level` with cube key `key` (at that level): uniform in
-    /// [-amplitude, amplitude) with 24 random bits, so the scaling to [-1, 1) is exact in f32.
-    pub fn displacement(&self, level: u32, key: I64Vec3) -> f32 {
+    /// The height of the point created at `level` with cube key `key` (at that level) between the four heights
+    /// `around`: their average plus a random displacement, uniform in [-a, a) with 24 random bits (so the scaling
+    /// to [-1, 1) is exact in f32), where a is the level's amplitude times the point's share of it: `flat_share`
+    /// where the four lie level, growing with their spread to all of it from [`STEEP_SPREAD`] amplitudes (beyond
+    /// the thesis: rough slopes and smooth floodplains, docs/planet.md, "Detail that follows the slope"). Every
+    /// operation rounds once, in the order glsl/heights_refine.comp takes, so CPU and GPU agree bit for bit.
+    pub fn displaced(&self, around: [f32; 4], level: u32, key: I64Vec3) -> f32 {
+        let (average, spread) = sorted_average_and_spread(around);
         let h = lattice_hash(self.seed, level, [key.x as u32, key.y as u32, key.z as u32]);
         let unit = (h >> 8) as f32 * (1.0 / 16_777_216.0) * 2.0 - 1.0;
-        unit * self.amplitude_at(level)
+        // The spread in units of the level's amplitude, less the amplitude itself: times 2^level, exact.
+        let levels = f32::from_bits((127 + level.min(127)) << 23);
+        let share = (self.flat_share + (spread * levels) * self.spread_gain).min(1.0);
+        average + unit * (self.amplitude_at(level) * share)
     }
 
     /// How far below the lowest (or above the highest) height of a patch at `level`, border included, any
@@ -78,9 +113,14 @@ impl DetailRule {
 }
 
 /// The average of four neighbours in ascending order of value: the same bits whatever order they come in.
-pub fn sorted_average(mut v: [f32; 4]) -> f32 {
+pub fn sorted_average(v: [f32; 4]) -> f32 {
+    sorted_average_and_spread(v).0
+}
+
+/// [`sorted_average`] and the highest of the four less the lowest.
+fn sorted_average_and_spread(mut v: [f32; 4]) -> (f32, f32) {
     v.sort_by(|a, b| a.total_cmp(b));
-    (v[0] + v[1] + v[2] + v[3]) * 0.25
+    ((v[0] + v[1] + v[2] + v[3]) * 0.25, v[3] - v[0])
 }
 
 fn axis(v: glam::DVec3) -> I64Vec3 {
@@ -230,8 +270,10 @@ pub fn refine(parent: &PatchHeights, child: PatchId, rule: &DetailRule) -> Patch
     let diamond = |g: (i64, i64)| {
         let corners =
             [(-1, -1), (1, -1), (-1, 1), (1, 1)].map(|(di, dj)| parent_at((g.0 + di, g.1 + dj)));
-        let average = sorted_average(corners);
-        amp_key(g).map_or(average, |k| average + rule.displacement(level, k))
+        amp_key(g).map_or_else(
+            || sorted_average(corners),
+            |k| rule.displaced(corners, level, k),
+        )
     };
     // Diamond centres from one point beyond the border on each side (odd coordinates only).
     let reach = BORDER + 1;
@@ -259,9 +301,54 @@ pub fn refine(parent: &PatchHeights, child: PatchId, rule: &DetailRule) -> Patch
             _ => {
                 let neighbours = [(-1, 0), (1, 0), (0, -1), (0, 1)]
                     .map(|(di, dj)| value(unfold_neighbour(cells, g, (g.0 + di, g.1 + dj))));
-                let average = sorted_average(neighbours);
-                amp_key(g).map_or(average, |k| average + rule.displacement(level, k))
+                amp_key(g).map_or_else(
+                    || sorted_average(neighbours),
+                    |k| rule.displaced(neighbours, level, k),
+                )
             }
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The largest displacement of the diamond centres of a level-4 patch refined from a tilted plane rising
+    /// `slope` per parent lattice step (a plane's centres average to the plane exactly).
+    fn largest_displacement(rule: &DetailRule, slope: f32) -> f32 {
+        let child = PatchId {
+            face: 0,
+            level: 4,
+            x: 5,
+            y: 6,
+        };
+        let parent = child.parent().unwrap();
+        let plane = |gi: f64| (slope as f64 * gi) as f32;
+        let heights = PatchHeights::from_fn(parent, 33, |(gi, _)| plane(gi as f64));
+        let refined = refine(&heights, child, rule);
+        let (x0, y0) = origin(child, 33);
+        (0..16)
+            .flat_map(|cj| (0..16).map(move |ci| (x0 + 2 * ci + 1, y0 + 2 * cj + 1)))
+            .map(|g| (refined.at(g) - plane(g.0 as f64 / 2.0)).abs())
+            .fold(0.0, f32::max)
+    }
+
+    #[test]
+    fn detail_follows_the_slope_and_the_thesis_keeps_it_everywhere() {
+        let amplitude = DetailRule::new(7, 2.0, 1.0).amplitude_at(4);
+        let thesis = DetailRule::new(7, 2.0, 1.0);
+        let shaped = DetailRule::new(7, 2.0, 0.15);
+        // The thesis: the whole amplitude on level ground.
+        assert!(largest_displacement(&thesis, 0.0) > 0.9 * amplitude);
+        // Level ground: the flat share of it.
+        let flat = largest_displacement(&shaped, 0.0);
+        assert!(
+            flat <= 0.15 * amplitude && flat > 0.13 * amplitude,
+            "{flat} of {amplitude}"
+        );
+        // A slope whose diamond corners spread STEEP_SPREAD amplitudes and more: all of it.
+        let steep = largest_displacement(&shaped, STEEP_SPREAD * amplitude);
+        assert!(steep > 0.9 * amplitude, "{steep} of {amplitude}");
+    }
 }

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::{
     cube::{PatchId, FACES, FACE_AXES},
-    detail::{self, sorted_average, DetailRule, PatchHeights},
+    detail::{self, DetailRule, PatchHeights},
 };
 
 /// Heights of the six faces at `cells` cells per face edge: `(cells + 1)^2` values per face, row-major (j rows of
@@ -99,8 +99,8 @@ impl FaceLattice {
         let c = self.cells;
         let side = self.side();
         // The key at the new points' level: this lattice's key divided by the stride of that level.
-        let noise = |key: I64Vec3| rule.displacement(level, key / half as i64);
-        let average = sorted_average;
+        let displaced =
+            |around: [f32; 4], key: I64Vec3| rule.displaced(around, level, key / half as i64);
 
         // Diamond step: the centre of every cell of the coarser level.
         let centres: Vec<(usize, f32)> = (0..FACES)
@@ -119,7 +119,7 @@ impl FaceLattice {
                         let (x, y) = (i + half, j + half);
                         (
                             lattice.index(face, x, y),
-                            average(corners) + noise(lattice.key(face, x, y)),
+                            displaced(corners, lattice.key(face, x, y)),
                         )
                     })
                 })
@@ -177,7 +177,7 @@ impl FaceLattice {
                         ];
                         Some((
                             y as usize * side + x as usize + face * side * side,
-                            average(values) + noise(key),
+                            displaced(values, key),
                         ))
                     })
                 })

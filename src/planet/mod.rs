@@ -150,10 +150,7 @@ impl Planet {
         };
         let seed64 = seed as u64;
         let precomputed_level = PRECOMPUTED_LEVEL.min(r.max_level_of_detail).max(base_level);
-        let rule = DetailRule {
-            seed,
-            amplitude: p.detail_amplitude,
-        };
+        let rule = DetailRule::new(seed, p.detail_amplitude, p.flat_detail);
 
         // Heights from a file (beyond the thesis): read and checked before any work.
         let t = Instant::now();
