@@ -194,7 +194,8 @@ fn a_planet_exported_and_read_back_is_the_same_planet() {
 }
 
 /// The same planet as 16-bit PNG (its height scale and offset in the JSON beside it) and OpenEXR reads as the TIFF
-/// does: the EXR's heights equal, the PNG's within half its height step.
+/// does: the EXR's heights equal, the PNG's within half its height step; and the TIFF written again with Deflate
+/// compression (as GIS tools often write DEMs) equal.
 #[test]
 fn every_format_export_writes_reads_back_alike() {
     let dir = temp_dir("formats");
@@ -203,6 +204,23 @@ fn every_format_export_writes_reads_back_alike() {
         TerrainFile::load(&path, (1.0, 0.0), 0.4).unwrap()
     };
     let (tiff, exr, png) = (read("tiff", "tif"), read("exr", "exr"), read("png", "png"));
+    let deflated = dir.join("deflated.tif");
+    {
+        let file = std::fs::File::open(dir.join("world.tif")).unwrap();
+        let mut decoder = tiff::decoder::Decoder::new(std::io::BufReader::new(file)).unwrap();
+        let tiff::decoder::DecodingResult::F32(heights) = decoder.read_image().unwrap() else {
+            panic!("the export is 32-bit float");
+        };
+        let out = std::fs::File::create(&deflated).unwrap();
+        tiff::encoder::TiffEncoder::new(out)
+            .unwrap()
+            .with_compression(tiff::encoder::Compression::Deflate(
+                tiff::encoder::DeflateLevel::Balanced,
+            ))
+            .write_image::<tiff::encoder::colortype::Gray32Float>(256, 128, &heights)
+            .unwrap();
+    }
+    let deflated = TerrainFile::load(&deflated, (1.0, 0.0), 0.4).unwrap();
     let metadata: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("world.json")).unwrap()).unwrap();
     let step = metadata["height_scale"].as_f64().unwrap();
@@ -217,6 +235,11 @@ fn every_format_export_writes_reads_back_alike() {
                 tiff.height_towards(p),
                 exr.height_towards(p),
                 "pixel ({x}, {y})"
+            );
+            assert_eq!(
+                tiff.height_towards(p),
+                deflated.height_towards(p),
+                "pixel ({x}, {y}) of the Deflate TIFF"
             );
             largest = largest.max((tiff.height_towards(p) - png.height_towards(p)).abs());
         }
