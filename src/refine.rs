@@ -130,7 +130,7 @@ impl HeightRefiner {
             seed: planet.rule.seed,
             amplitude: planet.rule.amplitude,
             flat_share: planet.rule.flat_share,
-            spread_gain: planet.rule.spread_gain,
+            spread_gain: planet.rule.spread_gain(),
         };
         let push = bytemuck::bytes_of(&push);
         let row = std::mem::size_of::<GpuRefineJob>();

@@ -126,7 +126,7 @@ pub struct RefinePush {
     pub amplitude: f32,
     /// flat-detail: the displacement's share on level ground (`DetailRule::flat_share`).
     pub flat_share: f32,
-    /// `DetailRule::spread_gain`.
+    /// `DetailRule::spread_gain()`.
     pub spread_gain: f32,
 }
 

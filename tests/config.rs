@@ -164,15 +164,20 @@ fn widths_must_be_positive() {
     assert!(msg.contains("must not exceed starting-width"), "{msg}");
 }
 
-#[test]
-fn the_interior_rise_lies_between_0_and_20() {
-    for bad in ["-0.5", "21", "1e30"] {
-        let msg = error_of(&with("planet-attributes", "interior-rise", bad));
+/// Each of `bads` as `<planet-attributes>`'s `element` is refused with an error naming the element and `range`.
+fn assert_out_of_range(element: &str, bads: &[&str], range: &str) {
+    for bad in bads {
+        let msg = error_of(&with("planet-attributes", element, bad));
         assert!(
-            msg.contains("<interior-rise>") && msg.contains("[0, 20]"),
+            msg.contains(&format!("<{element}>")) && msg.contains(range),
             "{msg}"
         );
     }
+}
+
+#[test]
+fn the_interior_rise_lies_between_0_and_20() {
+    assert_out_of_range("interior-rise", &["-0.5", "21", "1e30"], "[0, 20]");
     let earth =
         Config::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/earth.xml"))
             .unwrap();
@@ -187,13 +192,7 @@ fn the_interior_rise_lies_between_0_and_20() {
 
 #[test]
 fn the_flat_detail_is_a_share_between_0_and_1() {
-    for bad in ["-0.1", "1.5", "nan"] {
-        let msg = error_of(&with("planet-attributes", "flat-detail", bad));
-        assert!(
-            msg.contains("<flat-detail>") && msg.contains("[0, 1]"),
-            "{msg}"
-        );
-    }
+    assert_out_of_range("flat-detail", &["-0.1", "1.5", "nan"], "[0, 1]");
     // Not yet the default (docs/planet.md, "Detail that follows the slope").
     assert_eq!(
         Config::defaults_for(RiverModel::Drainage)
@@ -205,13 +204,11 @@ fn the_flat_detail_is_a_share_between_0_and_1() {
 
 #[test]
 fn the_network_diffusivity_lies_between_0_and_a_thousandth() {
-    for bad in ["-1e-4", "0.002", "nan"] {
-        let msg = error_of(&with("planet-attributes", "network-diffusivity", bad));
-        assert!(
-            msg.contains("<network-diffusivity>") && msg.contains("[0, 0.001]"),
-            "{msg}"
-        );
-    }
+    assert_out_of_range(
+        "network-diffusivity",
+        &["-1e-4", "0.002", "nan"],
+        "[0, 0.001]",
+    );
     let planet = Config::defaults_for(RiverModel::Drainage).planet;
     assert_eq!(planet.network_diffusivity, 0.0);
 }

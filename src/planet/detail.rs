@@ -55,9 +55,9 @@ pub struct DetailRule {
     /// `flat-detail`: the share of the displacement a point gets where its four neighbours lie level; 1 (the
     /// thesis, 3.6) gives every point all of it.
     pub flat_share: f32,
-    /// How fast the share grows with the neighbours' spread: `(1 - flat_share) / (STEEP_SPREAD x amplitude)`,
-    /// rounded once here so that the shader multiplies by the same f32.
-    pub spread_gain: f32,
+    /// How fast the share grows with the neighbours' spread ([`Self::spread_gain`]): set with the other two by
+    /// [`Self::new`], never apart from them.
+    spread_gain: f32,
 }
 
 /// The spread of a point's four neighbours (highest less lowest), in amplitudes of its level, from which it gets
@@ -79,6 +79,12 @@ impl DetailRule {
             flat_share,
             spread_gain,
         }
+    }
+
+    /// `(1 - flat_share) / (STEEP_SPREAD x amplitude)`, rounded once, so that the shader (which gets it as a push
+    /// constant) multiplies by the same f32 as the CPU.
+    pub fn spread_gain(&self) -> f32 {
+        self.spread_gain
     }
 
     /// The displacement amplitude of points created at `level`: a multiplication by the exact f32 of 2^-level
