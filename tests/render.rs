@@ -171,45 +171,70 @@ fn share_near(a: &[bool], b: &[bool], width: usize, radius: usize) -> f64 {
 /// Beyond the thesis: a river is painted where it is, whatever the level of detail. Rivers narrower than the
 /// vertex spacing are painted from signed distances measured at the vertices; where a triangle's vertices measured
 /// different rivers, the interpolated distance crossed zero between them and painted lines where no river is
-/// (before the slope test in terrain.frag), and the coarser the patches, the more of them. The river view drawn
-/// with patches of at most level 4 (vertices 4 units apart) must paint rivers only where the same view with
-/// level 6 (1 unit) paints them, and most of those. (Lakes are not held to it: in the painted mode a lake is painted
-/// over its samples' reach, a cell beyond its points, where vertices happen to fall; the other modes draw it to the
-/// terrain's contour.) The meanders below the base lattice are off: they appear between the two levels, moving the
-/// course by design.
+/// (before the slope test in terrain.frag), and the coarser the patches, the more of them. The river view and three
+/// views straight down on its target (25, 50 and 100 units above it) drawn with patches of at most level 4
+/// (vertices 4 units apart) must paint rivers mostly where the same views with level 6 (1 unit) paint them, and
+/// show most of those. Several views, because one view's share depends on what lies in it: the level-4 painting
+/// also differs where the drawn course changes between the levels (bends that level 6 resolves and level 4 draws
+/// straight) and at confluences of three wide rivers or more, whose vertices each measured another river
+/// (docs/rendering.md, "Painted rivers between vertices", has the measures). (Lakes are not held to it: in the
+/// painted mode a lake is painted over its samples' reach, a cell beyond its points, where vertices happen to
+/// fall; the other modes draw it to the terrain's contour.) The meanders below the base lattice are off: they
+/// appear between the two levels, moving the course by design.
 #[test]
 fn painted_rivers_lie_where_the_rivers_are_at_any_level_of_detail() {
     let Some(ctx) = common::gpu() else { return };
     let world = world_without_fine_meanders();
     let size = [640, 360];
-    let camera = preset_camera(Preset::River, size[0] as f64 / size[1] as f64);
-    let painted = |max_level: u32| {
-        let mut config = world.config.clone();
-        config.rendering.max_level_of_detail = max_level;
-        paint_rivers_red(
-            ctx,
-            (world, &camera),
-            size,
-            &config,
-            LodRule::Distance,
-            "level",
-            max_level,
-        )
-    };
-    let fine = painted(6);
-    let coarse = painted(4);
+    let aspect = size[0] as f64 / size[1] as f64;
+    let (_, target) = presets::camera(Preset::River, world).unwrap();
+    let mut views = vec![("river".to_string(), preset_camera(Preset::River, aspect))];
+    for above in [25.0, 50.0, 100.0] {
+        // A unit aside, so that the view's up (the eye's direction) is not its forward.
+        let eye =
+            (target + target.any_orthonormal_vector()).normalize() * (target.length() + above);
+        let near = riverplanet::runtime::camera::near_plane(above);
+        views.push((
+            format!("down{above}"),
+            Camera::look_at(eye, target, 45.0, aspect, near),
+        ));
+    }
     let width = size[0] as usize;
-    let on_rivers = share_near(&coarse, &fine, width, 2);
-    let shown = share_near(&fine, &coarse, width, 2);
-    let count = |mask: &[bool]| mask.iter().filter(|&&m| m).count();
-    eprintln!(
-        "painted pixels: level 4 {}, level 6 {}; level 4 within 2 pixels of level 6: {on_rivers:.3}; level 6 \
-         within 2 pixels of level 4: {shown:.3}",
-        count(&coarse),
-        count(&fine)
-    );
+    let count = |mask: &[bool]| mask.iter().filter(|&&m| m).count() as f64;
+    let (mut coarse_near, mut coarse_all, mut fine_near, mut fine_all) = (0.0, 0.0, 0.0, 0.0);
+    for (name, camera) in &views {
+        let painted = |max_level: u32| {
+            let mut config = world.config.clone();
+            config.rendering.max_level_of_detail = max_level;
+            paint_rivers_red(
+                ctx,
+                (world, camera),
+                size,
+                &config,
+                LodRule::Distance,
+                &format!("level-{name}"),
+                max_level,
+            )
+        };
+        let fine = painted(6);
+        let coarse = painted(4);
+        let on_rivers = share_near(&coarse, &fine, width, 2);
+        let shown = share_near(&fine, &coarse, width, 2);
+        eprintln!(
+            "{name}: painted pixels level 4 {}, level 6 {}; level 4 within 2 pixels of level 6: {on_rivers:.3}; \
+             level 6 within 2 pixels of level 4: {shown:.3}",
+            count(&coarse),
+            count(&fine)
+        );
+        coarse_near += on_rivers * count(&coarse);
+        coarse_all += count(&coarse);
+        fine_near += shown * count(&fine);
+        fine_all += count(&fine);
+    }
+    let (on_rivers, shown) = (coarse_near / coarse_all, fine_near / fine_all);
+    eprintln!("all views: {on_rivers:.3} and {shown:.3}");
     assert!(
-        on_rivers > 0.95,
+        on_rivers > 0.9,
         "only {on_rivers:.3} of the rivers painted with level 4 lie on rivers painted with level 6"
     );
     assert!(
@@ -744,7 +769,10 @@ fn the_water_moves_with_time_and_the_land_does_not() {
 }
 
 /// Beyond the thesis: the vertex cache (vertices computed once a frame in a compute pass) draws what the vertex
-/// shaders compute when it is off (the thesis's way), up to its f16 atmosphere.
+/// shaders compute when it is off (the thesis's way), up to its f16 atmosphere. Pixels on the planet's outline (beside
+/// the clear colour) are left out: the compute and vertex shaders round the positions a little differently, so the
+/// sea's triangles there cover a pixel in one and not in the other, and without the air the sky's reflection at
+/// grazing incidence then differs by up to 49 levels in a pixel or a few, 9 with the air. Elsewhere at most 2.
 #[test]
 fn the_vertex_cache_draws_what_the_vertex_shaders_compute() {
     let Some(ctx) = common::gpu() else { return };
@@ -755,18 +783,31 @@ fn the_vertex_cache_draws_what_the_vertex_shaders_compute() {
         .flat_map(|p| [(p, true), (p, false)])
     {
         let camera = preset_camera(preset, size[0] as f64 / size[1] as f64);
-        let at = |cached: bool| {
+        let at = |cached: bool, air: bool| {
             render_with(ctx, &camera, size, |r| {
                 r.water_mode = WaterMode::Geometry;
                 r.water_in_mesh = in_mesh;
                 r.cache_vertices = cached;
+                r.atmosphere_on = air;
             })
         };
-        let (cached, computed) = (at(true), at(false));
+        let (cached, computed) = (at(true, true), at(false, true));
+        // The outline: beside a pixel of the clear colour without the air (with it, the limb's glow covers it).
+        let space = at(true, false);
+        let clear = image::Rgba(CLEAR.map(|c| (c * 255.0) as u8));
+        let (w, h) = cached.dimensions();
+        let on_outline = |x: u32, y: u32| {
+            (y.saturating_sub(1)..(y + 2).min(h)).any(|v| {
+                (x.saturating_sub(1)..(x + 2).min(w)).any(|u| *space.get_pixel(u, v) == clear)
+            })
+        };
         let largest = cached
-            .pixels()
-            .zip(computed.pixels())
-            .flat_map(|(p, q)| (0..3).map(|c| (p.0[c] as i32 - q.0[c] as i32).abs()))
+            .enumerate_pixels()
+            .filter(|&(x, y, _)| !on_outline(x, y))
+            .flat_map(|(x, y, p)| {
+                let q = computed.get_pixel(x, y);
+                (0..3).map(move |c| (p.0[c] as i32 - q.0[c] as i32).abs())
+            })
             .max()
             .unwrap();
         let (mean, _) = compare(&cached, &computed);
@@ -774,7 +815,7 @@ fn the_vertex_cache_draws_what_the_vertex_shaders_compute() {
             "{preset:?}, water in the mesh {in_mesh}: mean difference {mean:.4}, largest {largest}"
         );
         assert!(
-            mean < 0.05 && largest <= 8,
+            mean < 0.05 && largest <= 4,
             "{preset:?}: the cached vertices draw another image (mean difference {mean:.4}, largest {largest})"
         );
     }
