@@ -93,6 +93,14 @@ fn the_level_of_detail_rule_and_pixel_error_are_named_or_refused() {
     );
     let message = error_of(&with("rendering-attributes", "pixel-error", "0"));
     assert!(message.contains("<pixel-error>"), "{message}");
+    // 0 turns the painted rivers' term off; below it is an error.
+    let message = error_of(&with("rendering-attributes", "river-pixel-error", "-1"));
+    assert!(
+        message.contains("<river-pixel-error>") && message.contains(">= 0"),
+        "{message}"
+    );
+    let off = Config::parse(&with("rendering-attributes", "river-pixel-error", "0"), "t").unwrap();
+    assert_eq!(off.rendering.river_pixel_error, 0.0);
 }
 
 #[test]

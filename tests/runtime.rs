@@ -4,13 +4,14 @@ use std::{collections::BTreeSet, sync::Arc};
 
 use glam::{DVec3, DVec4};
 use riverplanet::{
+    drainage::meanders::apex_curvature,
     planet::cube::{self, PatchId, FACES},
     rng::Rng,
     runtime::{
         camera::Camera,
         cull::{beyond_horizon, visible_quadrants, Frustum, HeightRange},
         error_field::ErrorField,
-        lod::{refines, select, LodParams, Selected},
+        lod::{painted_bank_error, refines, select, LodParams, Selected},
     },
 };
 
@@ -330,4 +331,63 @@ fn far_side_patches_are_culled() {
     let back = PatchId::root(5);
     assert!(beyond_horizon(back, camera, RADIUS, range));
     assert!(!beyond_horizon(PatchId::root(4), camera, RADIUS, range));
+}
+
+/// A painted river's bank error (`lod::painted_bank_error`) bounds how far linear interpolation over the mesh's
+/// right triangles moves the bank of the tightest bend, and is not loose: the signed distance to a circle of the
+/// apex's radius, sampled at the vertices of a grid of right triangles (random offset and rotation) and
+/// interpolated, misses its value on the banks by at most the bound and by more than a third of it somewhere. No
+/// error where the mesh carves the river (spacing below the half width), none beyond the half width.
+#[test]
+fn the_painted_bank_error_bounds_the_interpolated_banks_of_the_tightest_bend() {
+    let half_width = 1.0;
+    let radius = 1.0 / apex_curvature(half_width);
+    // The signed distance from the course, a circle about the origin; only its error counts.
+    let distance = |p: glam::DVec2| p.length() - radius;
+    let mut rng = Rng::new(7, &[]);
+    for spacing in [1.25, 1.5, 2.0] {
+        let bound = painted_bank_error(spacing, half_width);
+        assert!(bound > 0.0 && bound < half_width, "{spacing}: {bound}");
+        let mut worst: f64 = 0.0;
+        for _ in 0..20_000 {
+            let angle = rng.range_f64(0.0, 1.0) * std::f64::consts::TAU;
+            let (sin, cos) = angle.sin_cos();
+            let rotate =
+                |p: glam::DVec2| glam::DVec2::new(cos * p.x - sin * p.y, sin * p.x + cos * p.y);
+            let offset =
+                glam::DVec2::new(rng.range_f64(0.0, 1.0), rng.range_f64(0.0, 1.0)) * spacing;
+            // A point on either bank, in the grid's frame.
+            let side = if rng.range_f64(0.0, 1.0) < 0.5 {
+                -half_width
+            } else {
+                half_width
+            };
+            let along = rng.range_f64(0.0, 1.0) * std::f64::consts::TAU;
+            let bank = glam::DVec2::new(along.cos(), along.sin()) * (radius + side);
+            let local = rotate(bank) + offset;
+            let cell = (local / spacing).floor();
+            let (u, v) = (local.x / spacing - cell.x, local.y / spacing - cell.y);
+            let at = |i: f64, j: f64| {
+                let grid = (cell + glam::DVec2::new(i, j)) * spacing - offset;
+                distance(glam::DVec2::new(
+                    cos * grid.x + sin * grid.y,
+                    -sin * grid.x + cos * grid.y,
+                ))
+            };
+            let interpolated = if u + v < 1.0 {
+                at(0.0, 0.0) + u * (at(1.0, 0.0) - at(0.0, 0.0)) + v * (at(0.0, 1.0) - at(0.0, 0.0))
+            } else {
+                at(1.0, 1.0)
+                    + (1.0 - u) * (at(0.0, 1.0) - at(1.0, 1.0))
+                    + (1.0 - v) * (at(1.0, 0.0) - at(1.0, 1.0))
+            };
+            worst = worst.max((interpolated - distance(bank)).abs());
+        }
+        assert!(
+            worst <= bound && worst > bound / 3.0,
+            "spacing {spacing}: the banks miss by up to {worst:.4}, the bound is {bound:.4}"
+        );
+    }
+    assert_eq!(painted_bank_error(0.9, half_width), 0.0);
+    assert_eq!(painted_bank_error(40.0, half_width), half_width);
 }

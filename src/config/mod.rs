@@ -225,6 +225,10 @@ pub struct RenderingConfig {
     pub level_of_detail_rule: LodRule,
     /// Screen-space-error rule: the geometric error, in pixels, a patch may show before it is refined.
     pub pixel_error: f32,
+    /// Screen-space-error rule, beyond the thesis: how many pixels the banks of a river painted from its vertices
+    /// may stand from where they are (`runtime::lod::painted_bank_error`) before its patch is refined; 0: rivers
+    /// do not refine the mesh (the screen-space rule before it).
+    pub river_pixel_error: f32,
     /// Patch textures resident at once (bindless slots); least recently used are evicted beyond it.
     pub max_resident_patches: u32,
     /// New patches generated per frame at most; the rest draw their parent until their data arrives.
@@ -319,6 +323,7 @@ impl Config {
                 level_of_detail_switch_factor: 8.0,
                 level_of_detail_rule: LodRule::Distance,
                 pixel_error: 2.0,
+                river_pixel_error: 8.0,
                 max_resident_patches: 2048,
                 new_patches_per_frame: 64,
                 generation_budget_ms: 8.0,

@@ -197,6 +197,9 @@ const RENDERING: &[Param<RenderingConfig>] = &[
         choose(text, &mut c.level_of_detail_rule)
     }),
     Param::Number("pixel-error", Range::Positive, |c| &mut c.pixel_error),
+    Param::Number("river-pixel-error", Range::NonNegative, |c| {
+        &mut c.river_pixel_error
+    }),
     Param::Whole("max-resident-patches", 16, 1 << 20, |c| {
         &mut c.max_resident_patches
     }),

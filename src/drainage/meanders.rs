@@ -23,6 +23,12 @@ const FLAT_SWING: f64 = 1.25;
 /// fallen to half of the flat one. The median order-3 reach of the default planet has 0.22. At 0.5 seed 3's median
 /// stream sinuosity was 1.23, below the 1.3-1.6 of real lowland rivers; 0.7 gives 1.27-1.36 on seeds 1-6.
 const HALF_SWING_SLOPE: f64 = 0.7;
+/// The curvature at the apex of the tightest meander a river of `half_width` draws (a flat valley's): a
+/// sine-generated course turns at most `2 pi swing / wavelength` per unit of length.
+pub fn apex_curvature(half_width: f64) -> f64 {
+    2.0 * std::f64::consts::PI * FLAT_SWING / (WAVELENGTH_WIDTHS * 2.0 * half_width)
+}
+
 /// Courses swinging less than this (radians) stay on their valley line.
 pub const MIN_SWING: f64 = 0.05;
 /// Meanders shorter than this many base cells are left to the finer levels of detail (the thesis's subdivision).

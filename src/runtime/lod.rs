@@ -7,6 +7,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::error_field::ErrorField;
+use crate::drainage::meanders::apex_curvature;
 use crate::planet::{
     cube::{angle, PatchId, FACES},
     Planet,
@@ -28,14 +29,31 @@ pub fn threshold(radius: f64, switch_factor: f64, lod: u32) -> f64 {
 /// Beyond the thesis: the error of a level's river data, for the screen-space rule. The kernel measures rivers
 /// at the vertices within the influence distance of their samples (6.5), so on a level whose vertices are more
 /// than twice that apart (`spacing`, in the patch frame), a river or lake between two vertices reaches neither and
-/// is not drawn: water up to the widest's width (`widest`) is missing. Closer vertices always measure it, and
-/// banks interpolated from signed distances add no error of their own.
+/// is not drawn: water up to the widest's width (`widest`) is missing. Closer vertices always measure it (the banks
+/// painted from what they measured have an error of their own, [`painted_bank_error`]).
 pub fn river_error(spacing: f64, influence_distance: f64, widest: f64) -> f64 {
     if spacing > 2.0 * influence_distance {
         widest
     } else {
         0.0
     }
+}
+
+/// Beyond the thesis: how far a river painted from the signed distances at vertices `spacing` apart (in the patch
+/// frame) can draw its banks from where they are, for the screen-space rule; 0 where the mesh carves it instead
+/// (`spacing` below the `half_width`, Section 8.4's rule). Interpolated linearly, the signed distance to a straight
+/// river is exact, and the bank (where it equals the half width, changing by one unit per unit) lies where it is.
+/// Across a bend of curvature k the distance's second derivative at the inner bank is k / (1 - k w), and linear
+/// interpolation over a triangle misses by up to half of that times the square of its circumradius, s / sqrt 2 for
+/// the mesh's right triangles of legs s. The tightest bend is a meander's apex
+/// (`drainage::meanders::apex_curvature`, about 0.36 / w). At most the half width: a river drawn further aside
+/// is at worst a river of its width drawn elsewhere.
+pub fn painted_bank_error(spacing: f64, half_width: f64) -> f64 {
+    if half_width <= 0.0 || spacing < half_width {
+        return 0.0;
+    }
+    let k = apex_curvature(half_width);
+    (spacing * spacing / 4.0 * k / (1.0 - k * half_width)).min(half_width)
 }
 
 /// The parameters of the selection: the switch distance of every patch.

@@ -9,37 +9,109 @@ use super::{ms_since, FrameStats, Renderer};
 use crate::{
     config::{Config, LodRule},
     gpu::GpuError,
-    planet::{cube::PatchId, Planet},
+    planet::{
+        cube::{PatchId, FACES},
+        Planet,
+    },
     refine::with_ancestors,
     river::network::RiverNetwork,
     runtime::{
         camera::Camera,
         cull::{visible_quadrants, Frustum, HeightRange},
         error_field::ErrorField,
-        lod::{river_error, select, select_nearest, surface_bounds, LodParams, Selected},
+        lod::{
+            painted_bank_error, river_error, select, select_nearest, surface_bounds, LodParams,
+            Selected,
+        },
     },
 };
 
 /// The errors the screen-space rule projects (`ErrorField`): for a patch, the terrain's geometric error of its
-/// parent over its area, or what its parent level's river data can miss, whichever is larger. The patch frame's
-/// vertex spacing is the face's width (2 radii) over the level's vertices.
+/// parent over its area, what its parent level's river data can miss, or how far the parent paints the banks of
+/// the rivers crossing it from where they are (to level [`PAINTED_RIVER_LEVELS`]), whichever is larger. The
+/// patch frame's vertex spacing is the face's width (2 radii) over the level's vertices.
 pub(super) fn error_field(planet: &Planet, network: &RiverNetwork, config: &Config) -> ErrorField {
     let widest = network.widest();
     let segments = (config.rendering.vertices - 1) as f64;
-    let rivers = |level: u32| {
-        let spacing = 2.0 * planet.radius / (segments * (1u64 << level) as f64);
-        river_error(spacing, network.influence_distance, widest)
+    let spacing = |level: u32| 2.0 * planet.radius / (segments * (1u64 << level) as f64);
+    let rivers = |level: u32| river_error(spacing(level), network.influence_distance, widest);
+    let max_level = config.rendering.max_level_of_detail;
+    // The field is projected to `pixel-error` pixels; the banks' errors are scaled to be held to
+    // `river-pixel-error` pixels instead.
+    let r = &config.rendering;
+    let bank_scale = match r.river_pixel_error {
+        0.0 => 0.0,
+        pixels => (r.pixel_error / pixels) as f64,
     };
+    let painted = painted_errors(
+        network,
+        PAINTED_RIVER_LEVELS.min(max_level),
+        spacing,
+        bank_scale,
+    );
     ErrorField::new(
-        config.rendering.max_level_of_detail,
-        planet.precomputed_level,
+        max_level,
+        planet.precomputed_level.max(painted.len() as u32),
         |patch| {
+            let banks = painted
+                .get(patch.level as usize - 1)
+                .map_or(0.0, |errors| errors[patch_index(patch)]);
             planet
                 .quadrant_error(patch)
                 .max(rivers(patch.level as u32 - 1))
+                .max(banks)
         },
         |level| planet.geometric_error(level - 1).max(rivers(level - 1)),
     )
+}
+
+/// The finest level whose patches are visited by the painted rivers' bank error (`lod::painted_bank_error`):
+/// its parent's vertices are 2 units apart at radius 1024, so rivers wider than that are carved from it on, and
+/// finer levels for the narrow ones would refine around every stream near the camera.
+const PAINTED_RIVER_LEVELS: u32 = 6;
+
+/// A patch's place in its level's row of patches (face, then row-major).
+fn patch_index(patch: PatchId) -> usize {
+    let count = 1usize << patch.level;
+    (patch.face as usize * count + patch.y as usize) * count + patch.x as usize
+}
+
+/// Per level 1..=`levels` (index level - 1), per patch ([`patch_index`]): the largest bank error of a river
+/// crossing it painted at its parent's vertex `spacing` (`lod::painted_bank_error`), times `scale` (no level if
+/// 0). From points along every river's initial segments a sixteenth of a finest patch apart (2 units at level 6
+/// and radius 1024; lakes are drawn to their contour, not painted along a course).
+fn painted_errors(
+    network: &RiverNetwork,
+    levels: u32,
+    spacing: impl Fn(u32) -> f64,
+    scale: f64,
+) -> Vec<Vec<f64>> {
+    if scale == 0.0 {
+        return Vec::new();
+    }
+    // Two of the finest level's vertex spacings, a sixteenth of its patches.
+    let step = 2.0 * spacing(levels);
+    let mut errors: Vec<Vec<f64>> = (1..=levels)
+        .map(|level| vec![0.0; FACES * (1usize << (2 * level))])
+        .collect();
+    for system in &network.systems {
+        for segment in system.segments.iter().filter(|s| !s.lake) {
+            let chord = segment.curve.point(1.0).distance(segment.curve.point(0.0));
+            let steps = (chord / step).ceil().max(1.0) as usize;
+            for k in 0..=steps {
+                let t = k as f64 / steps as f64;
+                let direction = system.frame.to_sphere(segment.curve.point(t));
+                let half_width = 0.5 * segment.width_at(t) as f64;
+                for level in 1..=levels {
+                    let patch = PatchId::containing(direction, level as u8);
+                    let error = scale * painted_bank_error(spacing(level - 1), half_width);
+                    let slot = &mut errors[level as usize - 1][patch_index(patch)];
+                    *slot = slot.max(error);
+                }
+            }
+        }
+    }
+    errors
 }
 
 impl Renderer<'_> {
