@@ -167,6 +167,13 @@ impl PatchId {
         1 << self.level
     }
 
+    /// Its place among the patches of its level, faces in order and each row-major: the index of per-patch
+    /// tables of one level.
+    pub fn index(self) -> usize {
+        let count = self.count() as usize;
+        (self.face as usize * count + self.y as usize) * count + self.x as usize
+    }
+
     /// Side length in (u, v) units.
     pub fn size(self) -> f64 {
         2.0 / self.count() as f64

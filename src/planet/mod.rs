@@ -412,10 +412,10 @@ impl Planet {
     /// add (`DetailRule::remaining_range`, a bound, the same everywhere). Plus the sagitta of the parent's chords.
     pub fn quadrant_error(&self, patch: PatchId) -> f64 {
         let level = patch.level as u32 - 1;
-        let deviation = self.quadrant_deviations.get(level as usize).map(|d| {
-            let count = 1usize << patch.level;
-            d[(patch.face as usize * count + patch.y as usize) * count + patch.x as usize]
-        });
+        let deviation = self
+            .quadrant_deviations
+            .get(level as usize)
+            .map(|d| d[patch.index()]);
         self.error_with(level, deviation)
     }
 
@@ -443,9 +443,13 @@ impl Planet {
     pub fn patch_bounds(&self, patch: PatchId) -> (f32, f32) {
         let level = (patch.level as u32).min(self.precomputed_level);
         let shift = patch.level as u32 - level;
-        let count = 1usize << level;
-        let (x, y) = ((patch.x >> shift) as usize, (patch.y >> shift) as usize);
-        let (lo, hi) = self.bounds[level as usize][(patch.face as usize * count + y) * count + x];
+        let ancestor = PatchId {
+            level: level as u8,
+            x: patch.x >> shift,
+            y: patch.y >> shift,
+            ..patch
+        };
+        let (lo, hi) = self.bounds[level as usize][ancestor.index()];
         let extra = if shift > 0 {
             self.rule.remaining_range(level)
         } else {

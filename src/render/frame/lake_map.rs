@@ -92,11 +92,9 @@ impl LakeMap {
     /// Whether a lake reaches a lattice point of `patch` that the map holds; false for patches as fine as the map
     /// and finer, which draw their lakes in the mesh.
     pub(super) fn has_lakes(&self, patch: PatchId) -> bool {
-        let level = patch.level as usize;
-        let per_edge = 1usize << level;
-        self.patches_with_lakes.get(level).is_some_and(|flags| {
-            flags[(patch.face as usize * per_edge + patch.y as usize) * per_edge + patch.x as usize]
-        })
+        self.patches_with_lakes
+            .get(patch.level as usize)
+            .is_some_and(|flags| flags[patch.index()])
     }
 
     /// What the push constants carry of the map (`planet.z` above its six mode bits, glsl/terrain_common.glsl):

@@ -55,7 +55,7 @@ pub(super) fn error_field(planet: &Planet, network: &RiverNetwork, config: &Conf
         |patch| {
             let banks = painted
                 .get(patch.level as usize - 1)
-                .map_or(0.0, |errors| errors[patch_index(patch)]);
+                .map_or(0.0, |errors| errors[patch.index()]);
             planet
                 .quadrant_error(patch)
                 .max(rivers(patch.level as u32 - 1))
@@ -70,13 +70,7 @@ pub(super) fn error_field(planet: &Planet, network: &RiverNetwork, config: &Conf
 /// finer levels for the narrow ones would refine around every stream near the camera.
 const PAINTED_RIVER_LEVELS: u32 = 6;
 
-/// A patch's place in its level's row of patches (face, then row-major).
-fn patch_index(patch: PatchId) -> usize {
-    let count = 1usize << patch.level;
-    (patch.face as usize * count + patch.y as usize) * count + patch.x as usize
-}
-
-/// Per level 1..=`levels` (index level - 1), per patch ([`patch_index`]): the largest bank error of a river
+/// Per level 1..=`levels` (index level - 1), per patch (`PatchId::index`): the largest bank error of a river
 /// crossing it painted at its parent's vertex `spacing` (`lod::painted_bank_error`), times `scale` (no level if
 /// 0). From points along every river's initial segments a sixteenth of a finest patch apart (2 units at level 6
 /// and radius 1024; lakes are drawn to their contour, not painted along a course).
@@ -105,7 +99,7 @@ fn painted_errors(
                 for level in 1..=levels {
                     let patch = PatchId::containing(direction, level as u8);
                     let error = scale * painted_bank_error(spacing(level - 1), half_width);
-                    let slot = &mut errors[level as usize - 1][patch_index(patch)];
+                    let slot = &mut errors[level as usize - 1][patch.index()];
                     *slot = slot.max(error);
                 }
             }
