@@ -31,14 +31,14 @@ use crate::{
 /// the rivers crossing it from where they are (to level [`PAINTED_RIVER_LEVELS`]), whichever is larger. The
 /// patch frame's vertex spacing is the face's width (2 radii) over the level's vertices.
 pub(super) fn error_field(planet: &Planet, network: &RiverNetwork, config: &Config) -> ErrorField {
+    let r = &config.rendering;
     let widest = network.widest();
-    let segments = (config.rendering.vertices - 1) as f64;
+    let segments = (r.vertices - 1) as f64;
     let spacing = |level: u32| 2.0 * planet.radius / (segments * (1u64 << level) as f64);
     let rivers = |level: u32| river_error(spacing(level), network.influence_distance, widest);
-    let max_level = config.rendering.max_level_of_detail;
+    let max_level = r.max_level_of_detail;
     // The field is projected to `pixel-error` pixels; the banks' errors are scaled to be held to
     // `river-pixel-error` pixels instead.
-    let r = &config.rendering;
     let bank_scale = match r.river_pixel_error {
         0.0 => 0.0,
         pixels => (r.pixel_error / pixels) as f64,
