@@ -222,6 +222,27 @@ fn the_network_diffusivity_lies_between_0_and_a_thousandth() {
 }
 
 #[test]
+fn terrain_bounds_are_four_degrees_in_order_and_need_a_terrain_file() {
+    assert_out_of_range(
+        "terrain-bounds",
+        &[
+            "1,2,3",
+            "10,0,5,5",
+            "0,10,5,5",
+            "0,-91,5,5",
+            "-10,0,400,5",
+            "a,b,c,d",
+        ],
+        "must be WEST,SOUTH,EAST,NORTH in degrees",
+    );
+    let msg = error_of(&with("planet-attributes", "terrain-bounds", "5,44,17,49"));
+    assert!(
+        msg.contains("<terrain-bounds>") && msg.contains("needs relief-model file"),
+        "{msg}"
+    );
+}
+
+#[test]
 fn landmass_must_lie_strictly_between_0_and_100() {
     for bad in ["0", "100", "-1", "150.0f"] {
         let msg = error_of(&with("planet-attributes", "landmass-percentage", bad));

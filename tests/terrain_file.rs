@@ -201,7 +201,7 @@ fn every_format_export_writes_reads_back_alike() {
     let dir = temp_dir("formats");
     let read = |format: &str, extension: &str| {
         let path = export_world(&dir, "256x128", format, extension);
-        TerrainFile::load(&path, (1.0, 0.0), 0.4).unwrap()
+        TerrainFile::load(&path, (1.0, 0.0), 0.4, None).unwrap()
     };
     let (tiff, exr, png) = (read("tiff", "tif"), read("exr", "exr"), read("png", "png"));
     let deflated = dir.join("deflated.tif");
@@ -220,7 +220,7 @@ fn every_format_export_writes_reads_back_alike() {
             .write_image::<tiff::encoder::colortype::Gray32Float>(256, 128, &heights)
             .unwrap();
     }
-    let deflated = TerrainFile::load(&deflated, (1.0, 0.0), 0.4).unwrap();
+    let deflated = TerrainFile::load(&deflated, (1.0, 0.0), 0.4, None).unwrap();
     let metadata: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("world.json")).unwrap()).unwrap();
     let step = metadata["height_scale"].as_f64().unwrap();
@@ -278,13 +278,31 @@ fn files_that_cannot_be_a_planet_are_refused_first() {
             .write_image::<tiff::encoder::colortype::Gray32Float>(64, 32, &nan)
             .unwrap();
     }
+    // A GeoTIFF in a projected system (UTM metres), as many DEMs come.
+    write_geotiff(
+        &dir.join("projected.tif"),
+        (64, 32),
+        &[1.0; 64 * 32],
+        1,
+        [500000.0, 4e6, 30.0, 30.0],
+    );
     std::fs::write(dir.join("heights.txt"), "1 2 3").unwrap();
     let cases = [
         ("missing.tif", "", "cannot read terrain-file"),
         (
             "square.png",
             "",
-            "is 64x64; a whole planet's equirectangular raster must be twice as wide as high",
+            "has no georeference and is 64x64: a region needs GeoTIFF tags",
+        ),
+        (
+            "square.png",
+            "<terrain-bounds>10,40,10.5,40.5</terrain-bounds>",
+            "its region spans 0.500 x 0.500 degrees; it must span at least two of the base lattice's cells",
+        ),
+        (
+            "projected.tif",
+            "",
+            "its GeoTIFF model type is 1 (1: projected, 3: geocentric)",
         ),
         (
             "sea.png",
@@ -349,6 +367,149 @@ fn files_that_cannot_be_a_planet_are_refused_first() {
         let message = Config::load(&path).unwrap_err().to_string();
         assert!(message.contains(expected), "{replacement}: {message}");
     }
+}
+
+/// A 32-bit float GeoTIFF of `heights` with GTModelType `model` (2: longitude and latitude), its north-west corner
+/// at `(west, north)` and pixels `(dx, dy)` in the model's units: `[west, north, dx, dy]`.
+fn write_geotiff(
+    path: &Path,
+    (w, h): (u32, u32),
+    heights: &[f32],
+    model: u16,
+    [west, north, dx, dy]: [f64; 4],
+) {
+    use tiff::{encoder::colortype::Gray32Float, tags::Tag};
+    let file = std::fs::File::create(path).unwrap();
+    let mut encoder = tiff::encoder::TiffEncoder::new(file).unwrap();
+    let mut image = encoder.new_image::<Gray32Float>(w, h).unwrap();
+    let directory = image.encoder();
+    directory
+        .write_tag(
+            Tag::GeoKeyDirectoryTag,
+            &[1u16, 1, 0, 2, 1024, 0, 1, model, 1025, 0, 1, 1][..],
+        )
+        .unwrap();
+    directory
+        .write_tag(Tag::ModelPixelScaleTag, &[dx, dy, 0.0][..])
+        .unwrap();
+    directory
+        .write_tag(
+            Tag::ModelTiepointTag,
+            &[0.0, 0.0, 0.0, west, north, 0.0][..],
+        )
+        .unwrap();
+    image.write_data(heights).unwrap();
+}
+
+/// A region of seed 2 (`export region`, a GeoTIFF with its georeference) placed on seed 1's procedural planet:
+/// inside it the heights are seed 2's, far from it seed 1's, the coast between them blended, and the network drains
+/// it all (no uphill step, no crossing). A region's placement is read from its GeoTIFF tags, and
+/// `<terrain-bounds>` moves it.
+#[test]
+fn a_region_is_placed_on_the_procedural_planet() {
+    let dir = temp_dir("region");
+    let region = dir.join("region.tif");
+    let bounds = [-30.0, -20.0, 30.0, 25.0];
+    let bounds_text = format!("{},{},{},{}", bounds[0], bounds[1], bounds[2], bounds[3]);
+    succeeds(&[
+        "export",
+        "region",
+        "--seed",
+        "2",
+        "--bounds",
+        &bounds_text,
+        "--level",
+        "3",
+        "--out",
+        region.to_str().unwrap(),
+    ]);
+    let file = TerrainFile::load(&region, (1.0, 0.0), 0.4, None).unwrap();
+    assert!(file.is_region());
+    let placed = file.bounds();
+    assert!(
+        placed
+            .iter()
+            .zip(&bounds)
+            .all(|(a, b)| (a - b).abs() < 1e-9),
+        "placed at {placed:?}, exported at {bounds:?}"
+    );
+    let default_config = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/planet.xml");
+    let seed = |s: u32| {
+        let config = Config::load(&default_config).unwrap();
+        Planet::generate(&config, s, |_| {}).unwrap()
+    };
+    let (one, two) = (seed(1), seed(2));
+    let config = Config::load(&file_config(&dir, "region.tif", "")).unwrap();
+    let placed_planet = Planet::generate(&config, 1, |_| {}).unwrap();
+    let cell = std::f64::consts::FRAC_PI_2 / (config.planet.base_resolution - 1) as f64;
+    let rivers = [&one, &two, &placed_planet].map(|p| RiverPoints::new(p, 1));
+    let relief = (one.stats.max_height - one.stats.min_height) as f64;
+    // Relative height differences at whole degrees away from every river, inside the region's unblended core
+    // (against seed 2) and 15 degrees and more outside it (against seed 1).
+    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    for y in 0..180 {
+        for x in 0..360 {
+            let (lon, lat) = (x as f64 - 179.5, 89.5 - y as f64);
+            let p = direction_at(lon, lat);
+            let h = placed_planet.height_at(p) as f64;
+            let (west, south, east, north) = (bounds[0], bounds[1], bounds[2], bounds[3]);
+            let margin = |low: f64, high: f64, v: f64| (v - low).min(high - v) / (high - low);
+            let core = margin(west, east, lon) > 0.15 && margin(south, north, lat) > 0.15;
+            let far =
+                lon < west - 15.0 || lon > east + 15.0 || lat < south - 15.0 || lat > north + 15.0;
+            // Away from the rivers of the placed planet and of the one it is compared with.
+            let dry = |k: usize| !rivers[2].near(p, 2.0 * cell) && !rivers[k].near(p, 2.0 * cell);
+            if core && dry(1) {
+                inside.push((h - two.height_at(p) as f64).abs() / relief);
+            } else if far && dry(0) {
+                outside.push((h - one.height_at(p) as f64).abs() / relief);
+            }
+        }
+    }
+    let quantiles = |d: &mut Vec<f64>| {
+        d.sort_by(f64::total_cmp);
+        let at = |q: f64| d[((d.len() - 1) as f64 * q) as usize];
+        (d.len(), at(0.5), at(0.9))
+    };
+    let (inside, outside) = (quantiles(&mut inside), quantiles(&mut outside));
+    println!("inside the region against seed 2 (points, median, 90 %): {inside:?}; far outside against seed 1: {outside:?}");
+    assert!(
+        inside.0 > 200 && inside.1 < 0.01 && inside.2 < 0.03,
+        "inside: {inside:?}"
+    );
+    assert!(
+        outside.0 > 10_000 && outside.1 < 0.01,
+        "outside: {outside:?}"
+    );
+    let measures = &placed_planet.drainage.as_ref().unwrap().measures;
+    assert_eq!(
+        (measures.uphill_steps, measures.crossings),
+        (0, 0),
+        "uphill steps and crossings"
+    );
+
+    // <terrain-bounds> places the same file elsewhere: its heights move with it.
+    let moved = Config::load(&file_config(
+        &dir,
+        "region.tif",
+        "<terrain-bounds>60,-20,120,25</terrain-bounds>",
+    ))
+    .unwrap();
+    let moved_planet = Planet::generate(&moved, 1, |_| {}).unwrap();
+    let (here, there) = (direction_at(0.0, 2.5), direction_at(90.0, 2.5));
+    let file_height = file.height_towards(here);
+    println!(
+        "file {file_height:.3}, placed {:.3}, moved {:.3}",
+        placed_planet.height_at(here),
+        moved_planet.height_at(there)
+    );
+    assert!(
+        ((moved_planet.height_at(there) - placed_planet.height_at(here)) as f64).abs()
+            < 0.05 * relief,
+        "the moved region's centre stands at {} where the placed one's stands at {}",
+        moved_planet.height_at(there),
+        placed_planet.height_at(here)
+    );
 }
 
 /// A planet from a file renders and descends to the ground with no hole pixel and no validation error.

@@ -76,9 +76,13 @@ pub struct PlanetConfig {
     /// Eroded relief (beyond the thesis): hillslope diffusivity of the young relief while its drainage network
     /// forms (unit-sphere area per model time; 0, the default: the rivers alone).
     pub network_diffusivity: f32,
-    /// Relief `file` (beyond the thesis): the whole planet's heights as an equirectangular raster (TIFF, OpenEXR or
-    /// 16-bit PNG; docs/planet.md, "Heights from a file"); in a file, relative to the file's folder.
+    /// Relief `file` (beyond the thesis): the planet's heights as an equirectangular raster (TIFF, OpenEXR or
+    /// 16-bit PNG; docs/planet.md, "Heights from a file"), the whole sphere or a region; in a file, relative to
+    /// the file's folder.
     pub terrain_file: String,
+    /// Where `terrain_file` lies, `[west, south, east, north]` in degrees, over its GeoTIFF tags; `None`: from
+    /// the tags, or the whole sphere.
+    pub terrain_bounds: Option<[f64; 4]>,
     /// A 16-bit PNG terrain's heights: `terrain-height-offset + terrain-height-scale x value`, where no JSON
     /// beside the file gives them.
     pub terrain_height_scale: f32,
@@ -294,6 +298,7 @@ impl Config {
                 interior_rise: 0.0,
                 network_diffusivity: 0.0,
                 terrain_file: String::new(),
+                terrain_bounds: None,
                 terrain_height_scale: 1.0,
                 terrain_height_offset: 0.0,
             },

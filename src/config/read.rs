@@ -136,6 +136,10 @@ const PLANET: &[Param<PlanetConfig>] = &[
         &mut c.network_diffusivity
     }),
     Param::Path("terrain-file", |c| &mut c.terrain_file),
+    Param::Choice("terrain-bounds", |c, text| {
+        c.terrain_bounds = Some(parse_bounds(text)?);
+        Ok(())
+    }),
     Param::Number("terrain-height-scale", Range::Positive, |c| {
         &mut c.terrain_height_scale
     }),
@@ -512,5 +516,30 @@ impl Config {
         )?;
         config.check(path)?;
         Ok(config)
+    }
+}
+
+/// `WEST,SOUTH,EAST,NORTH` in degrees: west below east by at most 360, south below north within [-90, 90].
+fn parse_bounds(text: &str) -> Result<[f64; 4], String> {
+    let expected =
+        "must be WEST,SOUTH,EAST,NORTH in degrees, west below east by at most 360 and south below \
+                    north within [-90, 90] (e.g. 5,44,17,49)";
+    let numbers: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| expected.to_string())?;
+    match numbers[..] {
+        [w, s, e, n]
+            if [w, s, e, n].iter().all(|v| v.is_finite())
+                && w < e
+                && e - w <= 360.0
+                && -90.0 <= s
+                && s < n
+                && n <= 90.0 =>
+        {
+            Ok([w, s, e, n])
+        }
+        _ => Err(expected.to_string()),
     }
 }

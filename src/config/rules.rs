@@ -94,12 +94,15 @@ impl Config {
             ));
         }
         // Heights from a file: the file and the relief model name each other.
-        match (planet.relief_model == ReliefModel::File, planet.terrain_file.is_empty()) {
+        match (
+            planet.relief_model == ReliefModel::File,
+            planet.terrain_file.is_empty(),
+        ) {
             (true, true) => {
                 return Err(error(
                     "terrain-file",
                     String::new(),
-                    "must name a whole planet's height raster (.tif, .exr or .png) with relief-model file"
+                    "must name a height raster (.tif, .exr or .png) with relief-model file"
                         .to_string(),
                 ))
             }
@@ -111,6 +114,13 @@ impl Config {
                 ))
             }
             _ => {}
+        }
+        if let (Some(bounds), true) = (planet.terrain_bounds, planet.terrain_file.is_empty()) {
+            return Err(error(
+                "terrain-bounds",
+                format!("{bounds:?}"),
+                "places terrain-file: it needs relief-model file and a terrain-file".to_string(),
+            ));
         }
         let widest = river.starting_width * river.ending_factor.max(1.0);
         if river.influence_distance <= widest * 0.5 {

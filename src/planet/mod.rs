@@ -159,9 +159,30 @@ impl Planet {
                 Path::new(&p.terrain_file),
                 (p.terrain_height_scale, p.terrain_height_offset),
                 p.sea_level_height,
+                p.terrain_bounds,
             )?),
             _ => None,
         };
+        // A region lies on the procedural planet (eroded relief) and needs a few of its lattice's cells.
+        let region = terrain.as_ref().filter(|t| t.is_region());
+        if let Some(region) = region {
+            let [west, south, east, north] = region.bounds();
+            let cell = 90.0 / base_cells as f64;
+            if (east - west).min(north - south) < 2.0 * cell {
+                return Err(TerrainFileError::BadPlacement {
+                    path: p.terrain_file.clone(),
+                    message: format!(
+                        "its region spans {:.3} x {:.3} degrees; it must span at least two of the base \
+                         lattice's cells ({cell:.3} degrees with base-resolution {})",
+                        east - west,
+                        north - south,
+                        p.base_resolution
+                    ),
+                }
+                .into());
+            }
+        }
+        let whole_file = terrain.as_ref().filter(|t| !t.is_region());
         if terrain.is_some() {
             time("terrain file", t);
         }
@@ -183,7 +204,7 @@ impl Planet {
         // The continent map as a function of a threshold: an image gives land directly; the Voronoi diagram gives
         // each point's ratio of continental to water distance, and a weight turns ratios into land.
         // A terrain file's heights at the base lattice's points, which give its land and sea.
-        let file_heights: Option<Vec<f32>> = terrain.as_ref().map(|terrain| {
+        let file_heights: Option<Vec<f32>> = whole_file.map(|terrain| {
             points
                 .par_iter()
                 .map(|&(f, i, j)| terrain.height_towards(base.direction(base.key(f, i, j))) as f32)
@@ -254,10 +275,9 @@ impl Planet {
                     )
                 }
             };
+            let eroded = p.relief_model == ReliefModel::Eroded || region.is_some();
             let land = match &grid {
-                Some(grid) if p.relief_model == ReliefModel::Eroded => {
-                    coasts::roughen(grid, &base, &points, &land, seed64)
-                }
+                Some(grid) if eroded => coasts::roughen(grid, &base, &points, &land, seed64),
                 _ => land,
             };
             let continent_share: f64 = land
@@ -285,7 +305,9 @@ impl Planet {
                 }
                 Some(grid) => {
                     match p.relief_model {
-                        ReliefModel::Eroded => {
+                        // A whole planet's file heights are the relief.
+                        ReliefModel::File if region.is_none() => {}
+                        ReliefModel::Eroded | ReliefModel::File => {
                             erosion = Some(erosion::raise(
                                 &mut base,
                                 grid,
@@ -294,9 +316,10 @@ impl Planet {
                                 seed64,
                             ))
                         }
-                        // The file's heights are the relief.
-                        ReliefModel::File => {}
                         _ => relief::raise(&mut base, grid, p, seed64),
+                    }
+                    if let Some(region) = region {
+                        region.paste(&mut base);
                     }
                     time("relief", t);
                     progress("relief");
@@ -327,7 +350,7 @@ impl Planet {
                         seed,
                         landmass_percent: landmass * 100.0,
                         continent_percent: continent_share * 100.0,
-                        continents: if p.continents_from_file || terrain.is_some() {
+                        continents: if p.continents_from_file || whole_file.is_some() {
                             0
                         } else {
                             p.continents as usize

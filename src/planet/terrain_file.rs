@@ -1,11 +1,14 @@
-//! `<terrain-file>` (beyond the thesis; docs/planet.md, "Heights from a file"): a whole planet's heights from an
-//! equirectangular raster, the coarse levels of a planet whose drainage network is then routed on them. Reads
-//! what `riverplanet export equirect` writes (32-bit float TIFF, OpenEXR channel Y, 16-bit PNG with the height
-//! scale and offset in the JSON beside it) and other tools' rasters in those formats.
+//! `<terrain-file>` (beyond the thesis; docs/planet.md, "Heights from a file"): a planet's heights from an
+//! equirectangular raster, the coarse levels of a planet whose drainage network is then routed on them: the whole
+//! planet, or a georeferenced region placed on the procedural planet. Reads what `riverplanet export equirect`
+//! and `export region` write (32-bit float GeoTIFF, OpenEXR channel Y, 16-bit PNG with the height scale and
+//! offset in the JSON beside it) and other tools' rasters in those formats.
 
 use std::path::Path;
 
 use glam::DVec3;
+
+use super::{cube::FACES, heights::FaceLattice};
 
 /// Why a terrain file cannot be used; each names the file and what a usable one needs.
 #[derive(Debug, thiserror::Error)]
@@ -30,7 +33,7 @@ pub enum TerrainFileError {
     },
     #[error(
         "terrain-file {path} is all {what} at sea-level-height {sea_level} (heights {lowest} to {highest}); a \
-         planet needs land and sea"
+         whole planet needs land and sea"
     )]
     Uniform {
         path: String,
@@ -39,23 +42,113 @@ pub enum TerrainFileError {
         lowest: f32,
         highest: f32,
     },
+    #[error(
+        "terrain-file {path} has no georeference and is {width}x{height}: a region needs GeoTIFF tags \
+         (ModelTiepoint and ModelPixelScale in degrees, as `export region` writes) or <terrain-bounds>, and a whole \
+         planet's raster must be twice as wide as high"
+    )]
+    NoPlacement {
+        path: String,
+        width: u32,
+        height: u32,
+    },
+    #[error("terrain-file {path}: {message}")]
+    BadPlacement { path: String, message: String },
 }
 
-/// A whole planet's heights, row 0 in the north, column 0 at longitude -180 (pixel centres half a pixel in).
+/// Where a raster lies on the planet: the longitude of its west edge, the latitude of its north edge (degrees) and
+/// the degrees each pixel spans along longitude and latitude (pixels as areas, row 0 in the north).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub west: f64,
+    pub north: f64,
+    pub degrees_per_pixel: (f64, f64),
+}
+
+impl Placement {
+    /// The whole sphere, from longitude -180 and the north pole.
+    pub fn whole(width: u32, height: u32) -> Self {
+        Self {
+            west: -180.0,
+            north: 90.0,
+            degrees_per_pixel: (360.0 / width as f64, 180.0 / height as f64),
+        }
+    }
+
+    /// `[west, south, east, north]` in degrees over `width` x `height` pixels.
+    pub fn from_bounds([west, south, east, north]: [f64; 4], width: u32, height: u32) -> Self {
+        Self {
+            west,
+            north,
+            degrees_per_pixel: (
+                (east - west) / width as f64,
+                (north - south) / height as f64,
+            ),
+        }
+    }
+
+    /// `[west, south, east, north]` of `width` x `height` pixels.
+    pub fn bounds(&self, width: u32, height: u32) -> [f64; 4] {
+        let (dx, dy) = self.degrees_per_pixel;
+        [
+            self.west,
+            self.north - dy * height as f64,
+            self.west + dx * width as f64,
+            self.north,
+        ]
+    }
+
+    /// Whether `width` x `height` pixels cover the whole sphere.
+    pub fn covers_the_sphere(&self, width: u32, height: u32) -> bool {
+        let [_, south, east, north] = self.bounds(width, height);
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-6;
+        close(east - self.west, 360.0) && close(north, 90.0) && close(south, -90.0)
+    }
+
+    /// Why these bounds cannot place a raster on the sphere, if they cannot.
+    fn check(&self, width: u32, height: u32) -> Result<(), String> {
+        let [west, south, east, north] = self.bounds(width, height);
+        let finite = [west, south, east, north].iter().all(|v| v.is_finite());
+        if !(finite && west < east && east - west <= 360.0 + 1e-9) {
+            return Err(format!(
+                "its longitudes {west} to {east} must rise from west to east over at most 360 degrees"
+            ));
+        }
+        if !(-90.0 - 1e-9..=90.0 + 1e-9).contains(&south)
+            || !(-90.0 - 1e-9..=90.0 + 1e-9).contains(&north)
+            || south >= north
+        {
+            return Err(format!(
+                "its latitudes {south} to {north} must rise from south to north within [-90, 90]"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A raster's heights, row 0 in the north (pixel centres half a pixel in), where [`Placement`] says.
 pub struct TerrainFile {
     width: u32,
     height: u32,
     heights: Vec<f32>,
+    placement: Placement,
+    region: bool,
 }
 
+/// The share of a region's width and height over which its heights blend into the procedural planet's.
+pub const REGION_BLEND: f64 = 0.1;
+
 impl TerrainFile {
-    /// Reads `path` and checks it holds heights for every pixel, with land and sea at `sea_level`. A PNG's 16-bit
-    /// values become `height_offset + height_scale x value`, from the JSON beside it (`PATH.json`, as `export`
-    /// writes) where there is one, else from `scale_offset`.
+    /// Reads `path` and checks it holds heights for every pixel. A PNG's 16-bit values become `height_offset +
+    /// height_scale x value`, from the JSON beside it (`PATH.json`, as `export` writes) where there is one, else
+    /// from `scale_offset`. The raster lies where `bounds` (`[west, south, east, north]` in degrees) says, else
+    /// where a TIFF's GeoTIFF tags say, else over the whole sphere if it is twice as wide as high; a whole planet
+    /// needs land and sea at `sea_level`.
     pub fn load(
         path: &Path,
         scale_offset: (f32, f32),
         sea_level: f32,
+        bounds: Option<[f64; 4]>,
     ) -> Result<Self, TerrainFileError> {
         let name = path.display().to_string();
         let unreadable = |message: String| TerrainFileError::Unreadable {
@@ -66,10 +159,10 @@ impl TerrainFile {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        let (width, height, heights) = match extension.as_deref() {
+        let ((width, height, heights), tagged) = match extension.as_deref() {
             Some("tif" | "tiff") => read_tiff(path).map_err(unreadable)?,
-            Some("exr") => read_exr(path).map_err(unreadable)?,
-            Some("png") => read_png(path, scale_offset).map_err(unreadable)?,
+            Some("exr") => (read_exr(path).map_err(unreadable)?, None),
+            Some("png") => (read_png(path, scale_offset).map_err(unreadable)?, None),
             _ => {
                 return Err(unreadable(
                     "the name must end in .tif, .tiff, .exr or .png (32-bit float TIFF, OpenEXR channel Y, or \
@@ -78,7 +171,26 @@ impl TerrainFile {
                 ))
             }
         };
-        if width != 2 * height || height < 4 {
+        let placement = match (bounds, tagged) {
+            (Some(bounds), _) => Placement::from_bounds(bounds, width, height),
+            (None, Some(tagged)) => tagged,
+            (None, None) if width == 2 * height => Placement::whole(width, height),
+            (None, None) => {
+                return Err(TerrainFileError::NoPlacement {
+                    path: name,
+                    width,
+                    height,
+                })
+            }
+        };
+        placement
+            .check(width, height)
+            .map_err(|message| TerrainFileError::BadPlacement {
+                path: name.clone(),
+                message,
+            })?;
+        let region = !placement.covers_the_sphere(width, height);
+        if (!region && (width < 8 || height < 4)) || width < 2 || height < 2 {
             return Err(TerrainFileError::WrongSize {
                 path: name,
                 width,
@@ -95,7 +207,7 @@ impl TerrainFile {
         }
         let lowest = heights.iter().copied().fold(f32::INFINITY, f32::min);
         let highest = heights.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-        if lowest > sea_level || highest <= sea_level {
+        if !region && (lowest > sea_level || highest <= sea_level) {
             return Err(TerrainFileError::Uniform {
                 path: name,
                 what: if lowest > sea_level { "land" } else { "sea" },
@@ -108,17 +220,42 @@ impl TerrainFile {
             width,
             height,
             heights,
+            placement,
+            region,
         })
     }
 
-    /// The height towards direction `p`: bilinear between the four nearest pixel centres, across the
-    /// antimeridian; poleward of the first and last rows' centres, the row's value.
-    pub fn height_towards(&self, p: DVec3) -> f64 {
+    /// Whether the raster is a region on a procedural planet rather than the whole sphere.
+    pub fn is_region(&self) -> bool {
+        self.region
+    }
+
+    /// `[west, south, east, north]` in degrees.
+    pub fn bounds(&self) -> [f64; 4] {
+        self.placement.bounds(self.width, self.height)
+    }
+
+    /// Where direction `p` falls on the raster, in pixels from its north-west corner (longitudes east of the west
+    /// edge, wrapping once round the sphere).
+    fn pixel_of(&self, p: DVec3) -> (f64, f64) {
         let (lon, lat) = super::lon_lat(p);
-        let x = (lon + 180.0) / 360.0 * self.width as f64 - 0.5;
-        let y =
-            ((90.0 - lat) / 180.0 * self.height as f64 - 0.5).clamp(0.0, self.height as f64 - 1.0);
-        let (x0, y0) = (x.floor(), y.floor().min(self.height as f64 - 2.0));
+        let (dx, dy) = self.placement.degrees_per_pixel;
+        let east_of_west = (lon - self.placement.west).rem_euclid(360.0);
+        (east_of_west / dx, (self.placement.north - lat) / dy)
+    }
+
+    /// The height towards direction `p`: bilinear between the four nearest pixel centres; a whole planet's across
+    /// the antimeridian, a region's clamped to its edge pixels; poleward of the first and last rows' centres, the
+    /// row's value.
+    pub fn height_towards(&self, p: DVec3) -> f64 {
+        let (px, py) = self.pixel_of(p);
+        let (w, h) = (self.width as f64, self.height as f64);
+        let x = match self.region {
+            true => (px - 0.5).clamp(0.0, w - 1.0),
+            false => px - 0.5,
+        };
+        let y = (py - 0.5).clamp(0.0, h - 1.0);
+        let (x0, y0) = (x.floor().min(w - 2.0), y.floor().min(h - 2.0));
         let (fx, fy) = (x - x0, y - y0);
         let at = |i: f64, j: f64| {
             let i = (i as i64).rem_euclid(self.width as i64) as usize;
@@ -128,15 +265,54 @@ impl TerrainFile {
         let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
         top * (1.0 - fy) + bottom * fy
     }
+
+    /// Blends a region's heights into `lattice` (the procedural planet's), by [`TerrainFile::weight_towards`].
+    pub fn paste(&self, lattice: &mut FaceLattice) {
+        let side = lattice.cells + 1;
+        for face in 0..FACES {
+            for j in 0..side {
+                for i in 0..side {
+                    let p = lattice.direction(lattice.key(face, i, j));
+                    let weight = self.weight_towards(p);
+                    if weight > 0.0 {
+                        let index = lattice.index(face, i, j);
+                        let own = lattice.data[index] as f64;
+                        lattice.data[index] =
+                            (own + (self.height_towards(p) - own) * weight) as f32;
+                    }
+                }
+            }
+        }
+    }
+
+    /// How much of the height towards `p` the file gives: 1 on a whole planet and inside a region, falling
+    /// smoothly to 0 over the region's outer [`REGION_BLEND`] of its width and height, 0 outside it.
+    pub fn weight_towards(&self, p: DVec3) -> f64 {
+        if !self.region {
+            return 1.0;
+        }
+        let (px, py) = self.pixel_of(p);
+        let (u, v) = (px / self.width as f64, py / self.height as f64);
+        let ramp = |t: f64| {
+            let s = (t.min(1.0 - t) / REGION_BLEND).clamp(0.0, 1.0);
+            s * s * (3.0 - 2.0 * s)
+        };
+        if !(0.0..=1.0).contains(&u) || !(0.0..=1.0).contains(&v) {
+            return 0.0;
+        }
+        ramp(u) * ramp(v)
+    }
 }
 
 type Heights = (u32, u32, Vec<f32>);
 
-fn read_tiff(path: &Path) -> Result<Heights, String> {
+/// A TIFF's heights, and where its GeoTIFF tags place it, if they do.
+fn read_tiff(path: &Path) -> Result<(Heights, Option<Placement>), String> {
     use tiff::decoder::{Decoder, DecodingResult};
     let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
     let mut decoder = Decoder::new(std::io::BufReader::new(file)).map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().map_err(|e| e.to_string())?;
+    let placement = georeference(&mut decoder)?;
     let heights = match decoder.read_image().map_err(|e| e.to_string())? {
         DecodingResult::F32(v) => v,
         DecodingResult::F64(v) => v.into_iter().map(|h| h as f32).collect(),
@@ -150,7 +326,65 @@ fn read_tiff(path: &Path) -> Result<Heights, String> {
             )
         }
     };
-    one_channel(width, height, heights)
+    Ok((one_channel(width, height, heights)?, placement))
+}
+
+/// GeoTIFF 1.1 (OGC 19-008): ModelPixelScale and one ModelTiepoint in a geographic model in degrees (GTModelType 2,
+/// angular units 9102 where given); a raster of points (GTRasterType 2) covers half a pixel more on each side.
+fn georeference<R: std::io::Read + std::io::Seek>(
+    decoder: &mut tiff::decoder::Decoder<R>,
+) -> Result<Option<Placement>, String> {
+    use tiff::tags::Tag;
+    let mut doubles = |tag: Tag| -> Result<Option<Vec<f64>>, String> {
+        match decoder.find_tag(tag).map_err(|e| e.to_string())? {
+            Some(value) => value.into_f64_vec().map(Some).map_err(|e| e.to_string()),
+            None => Ok(None),
+        }
+    };
+    let (Some(scale), Some(tie)) = (
+        doubles(Tag::ModelPixelScaleTag)?,
+        doubles(Tag::ModelTiepointTag)?,
+    ) else {
+        return Ok(None);
+    };
+    if scale.len() < 2 || tie.len() < 6 || scale[0] <= 0.0 || scale[1] <= 0.0 {
+        return Err(format!(
+            "its GeoTIFF tags need ModelPixelScale (two positive numbers) and a ModelTiepoint (six numbers); it has \
+             {scale:?} and {tie:?}"
+        ));
+    }
+    let keys: Vec<u16> = match decoder
+        .find_tag(Tag::GeoKeyDirectoryTag)
+        .map_err(|e| e.to_string())?
+    {
+        Some(value) => value.into_u16_vec().map_err(|e| e.to_string())?,
+        None => Vec::new(),
+    };
+    let key = |id: u16| {
+        keys.get(4..)
+            .unwrap_or_default()
+            .chunks_exact(4)
+            .find(|k| k[0] == id && k[1] == 0)
+            .map(|k| k[3])
+    };
+    if let Some(model) = key(1024).filter(|&m| m != 2) {
+        return Err(format!(
+            "its GeoTIFF model type is {model} (1: projected, 3: geocentric); a terrain file must be in longitude \
+             and latitude (model type 2, e.g. EPSG:4326; reproject with gdalwarp -t_srs EPSG:4326)"
+        ));
+    }
+    if let Some(units) = key(2054).filter(|&u| u != 9102) {
+        return Err(format!(
+            "its GeoTIFF angular units are {units}; a terrain file's must be degrees (9102)"
+        ));
+    }
+    let (dx, dy) = (scale[0], scale[1]);
+    let half = if key(1025) == Some(2) { 0.5 } else { 0.0 };
+    Ok(Some(Placement {
+        west: tie[3] - (tie[0] + half) * dx,
+        north: tie[4] + (tie[1] + half) * dy,
+        degrees_per_pixel: (dx, dy),
+    }))
 }
 
 fn read_exr(path: &Path) -> Result<Heights, String> {
@@ -235,6 +469,8 @@ mod tests {
             width: 8,
             height: 4,
             heights,
+            placement: Placement::whole(8, 4),
+            region: false,
         };
         // Column 2's centre: longitude -180 + 2.5 x 45.
         let at = |lon: f64, lat: f64| file.height_towards(super::super::direction_at(lon, lat));
