@@ -239,6 +239,7 @@ const float RIVER_SLOPE_LIMIT = 1.6;
 // confluence's water, which stays. Half the unit slope is a bend of 120 degrees within one triangle.
 const float RIVER_SLOPE_FLOOR = 0.5;
 const float RIVER_FLAT_SPACING = 4.0;
+const float RIVER_JOIN_SPACING = 8.0;
 // Beyond the thesis: the largest change of the river half width per unit of length at which a triangle is taken
 // to measure one river. Along one river the width changes by a fraction of a percent per unit; a triangle with a
 // vertex nearest a finer level's stream (its own narrow width, docs/kernel.md) and one nearest the wide river
@@ -266,10 +267,6 @@ vec3 lakeMapCoord(vec3 d, float side) {
     vec2 uv = vec2(dot(p, FACE_U[face]), dot(p, FACE_V[face]));
     return vec3(((uv + 1.0) * 0.5 * (side - 1.0) + 0.5) / side, float(face));
 }
-
-// Beyond the thesis: a vertex a lake reaches reports a half width of 1e9 (docs/kernel.md, "Lakes"), so a triangle
-// with one has an interpolated half width far above any river's.
-const float LAKE_HALF_WIDTH_FLOOR = 1e6;
 
 void main() {
     vec3 sun = normalize(frame.sun.xyz);
@@ -299,6 +296,7 @@ void main() {
     // The pixel's footprint on the surface (world units), for the lakes drawn from the lake map.
     float footprint = sqrt(max(dot(px, px), dot(py, py)));
     vec2 dw = vec2(dFdx(fRiver.w), dFdy(fRiver.w));
+    float joinEdge = fwidth(fBank) + 1e-4;
     float zSlope = distanceSlope(dz, px, py);
     bool flatDistance = zSlope < RIVER_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * fRiver.w;
     bool measured = zSlope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw, px, py) <= WIDTH_SLOPE_LIMIT;
@@ -313,12 +311,18 @@ void main() {
     float ambient = 0.18 + 0.12 * max(dot(up, sun) + 0.3, 0.0);
     vec3 colour = albedo * (ambient + 0.85 * diffuse);
     // Section 8.4: paint a river the mesh is too coarse to carve (vertices not closer than half its width, the
-    // thesis's rule, in `auto`), from the signed distance and width; as water half a colour band deep. Not where
-    // the distance was measured to different rivers (beyond the thesis, distanceSlope).
+    // thesis's rule, in `auto`), from the signed distance and width; as water half a colour band deep. Where the
+    // distance was measured to different rivers (beyond the thesis, distanceSlope), at a confluence, the signed
+    // distances do not interpolate; the distances to the banks do (the union of the rivers' water, each vertex
+    // measuring the nearest): water where they interpolate below 0 (docs/rendering.md, "Painted confluences").
     uint mode = waterMode();
     bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
     float inBasin = fRiver.w > 0.0 ? 1.0 - smoothBand(fRiver.w - edge, fRiver.w + edge, abs(fRiver.z)) : 0.0;
-    float painted = paint && measured ? inBasin : 0.0;
+    // Only on triangles at most RIVER_JOIN_SPACING half widths across: a vertex beyond a river's end measures the
+    // line the river ends on, and from afar a large triangle with one would be painted whole.
+    bool joinable = fSpacing <= RIVER_JOIN_SPACING * fRiver.w;
+    float joined = joinable ? 1.0 - smoothBand(-joinEdge, joinEdge, fBank) : 0.0;
+    float painted = paint ? (measured ? inBasin : joined) : 0.0;
     // Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the sea and the rivers the mesh shows,
     // over the terrain's colour as the water pass blends them: where the terrain lies below the water's surface
     // (what the water pass's depth test decides) and, for a river, within its width (where the water pass cuts

@@ -51,6 +51,10 @@ struct PatchInstance {
     vec4 detail;      // xyz: the patch centre's world position modulo 65536 (computed in f64; render/frame/shader_data.rs)
 };
 
+// Beyond the thesis: a vertex a lake reaches reports a half width of 1e9 (docs/kernel.md, "Lakes"), so a triangle
+// with one has an interpolated half width far above any river's.
+const float LAKE_HALF_WIDTH_FLOOR = 1e6;
+
 // Whether a vertex of `surface` (terrain height, water height, signed distance, half width) lies in a river's
 // basin: |signed distance| < half width (Section 8.4; false where no river reaches, half width 0).
 bool inRiverBasin(vec4 surface) { return abs(surface.z) < surface.w; }

@@ -15,8 +15,9 @@ layout(location = 3) TERRAIN_IO vec4 ioDirectionFlowZ;  // unit direction from t
 layout(location = 4) TERRAIN_IO vec4 ioDetailSunR;      // world position mod DETAIL_PERIOD; the sunlight's red
 layout(location = 5) TERRAIN_IO vec4 ioInscatterSunG;   // the air's inscattered light (display value); sunlight green
 layout(location = 6) TERRAIN_IO vec4 ioTransmittanceSunB; // the air's transmittance from the eye; sunlight blue
-// River water (1) or not (0), the level, the vertex spacing: the same at a triangle's three vertices (so
-// interpolated, not flat, to share the slot); whether the vertex lies in a river basin (1) or not (0).
+// The water pass: river water (1) or not (0); the terrain pass: the distance to the banks of the river the vertex
+// measured (`bank`). The level, the vertex spacing: the same at a triangle's three vertices (so interpolated, not
+// flat, to share the slot); whether the vertex lies in a river basin (1) or not (0).
 layout(location = 7) TERRAIN_IO vec4 ioKindLevelSpacingBasin;
 
 // One vertex of what terrain.frag reads.
@@ -30,7 +31,8 @@ struct SurfaceVertex {
     vec3 sunlight;        // the sunlight that reaches the vertex
     vec3 inscatter;       // display value of the radiance the air scatters towards the eye
     vec3 transmittance;   // what the air between the eye and the vertex lets through
-    bool riverWater;
+    bool riverWater;      // the water pass only
+    float bank;           // the terrain pass only: |signed distance| - half width (negative in the river)
     float level;
     float spacing;
     bool inBasin;         // |signed distance| < half width
@@ -45,7 +47,7 @@ void writeSurface(SurfaceVertex v) {
     ioDetailSunR = vec4(v.detail, v.sunlight.r);
     ioInscatterSunG = vec4(v.inscatter, v.sunlight.g);
     ioTransmittanceSunB = vec4(v.transmittance, v.sunlight.b);
-    ioKindLevelSpacingBasin = vec4(v.riverWater ? 1.0 : 0.0, v.level, v.spacing, v.inBasin ? 1.0 : 0.0);
+    ioKindLevelSpacingBasin = vec4(v.riverWater ? 1.0 : v.bank, v.level, v.spacing, v.inBasin ? 1.0 : 0.0);
 }
 #else
 #define fPosition ioPositionFlowX.xyz
@@ -58,6 +60,7 @@ void writeSurface(SurfaceVertex v) {
 #define fInscatter ioInscatterSunG.xyz
 #define fTransmittance ioTransmittanceSunB.xyz
 #define fRiverWater ioKindLevelSpacingBasin.x
+#define fBank ioKindLevelSpacingBasin.x
 #define fLevel ioKindLevelSpacingBasin.y
 #define fSpacing ioKindLevelSpacingBasin.z
 // Above 0 where any vertex of the triangle lies in a river basin (the water pass's choice of river triangles).

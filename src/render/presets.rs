@@ -47,9 +47,6 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
     let sea = world.planet.sea_level as f64;
     // Distances in Appendix A's world units, and the world units they stand for on this planet.
     let unit = r / APPENDIX_A_RADIUS;
-    let river = &world.config.river;
-    let river_unit =
-        (river.starting_width * river.ending_factor.max(1.0)) as f64 / APPENDIX_A_WIDEST_RIVER;
     Some(match preset {
         Preset::Orbit => {
             let d = up(system.source + DVec3::Y * 0.25);
@@ -64,29 +61,7 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
                 top * (r + height(top)),
             )
         }
-        Preset::River => {
-            // The river as drawn at the scale of the view: pieces no longer than the look ahead.
-            let ahead = 40.0 * river_unit;
-            let coarse = lower_course(world, system);
-            let segment = finest_piece_near(
-                coarse,
-                coarse.curve.point(0.5),
-                ahead,
-                &world.network.params,
-            );
-            let middle = segment.curve.point(0.5);
-            let target = system.frame.to_sphere(middle);
-            let along = system
-                .frame
-                .to_sphere(middle + segment.curve.derivative(0.5).normalize() * ahead);
-            let back = (target - along).normalize();
-            // 0.03 radians of Appendix A's planet, at this planet's river scale.
-            let eye_dir = up(target + back * 0.03 * APPENDIX_A_RADIUS * river_unit / r);
-            (
-                eye_dir * (r + height(eye_dir).max(sea) + 25.0 * river_unit),
-                target * (r + height(target)),
-            )
-        }
+        Preset::River => river_view(world, system),
         Preset::Ground => {
             let segment = lower_course(world, system);
             // Where the deepest levels draw the river: its finest piece there.
@@ -106,6 +81,38 @@ pub fn camera(preset: Preset, world: &World) -> Option<(DVec3, DVec3)> {
             (here * (r + water + GROUND_EYE_HEIGHT), ahead * (r + water))
         }
     })
+}
+
+/// The river preset's eye and target for `system`: above the widest part of its lower course, looking down the
+/// river from behind.
+pub fn river_view(world: &World, system: &RiverSystem) -> (DVec3, DVec3) {
+    let r = world.planet.radius;
+    let height = |d: DVec3| world.planet.height_at(d) as f64;
+    // Appendix A's river distances at this planet's river scale.
+    let river = &world.config.river;
+    let river_unit =
+        (river.starting_width * river.ending_factor.max(1.0)) as f64 / APPENDIX_A_WIDEST_RIVER;
+    // The river as drawn at the scale of the view: pieces no longer than the look ahead.
+    let ahead = 40.0 * river_unit;
+    let coarse = lower_course(world, system);
+    let segment = finest_piece_near(
+        coarse,
+        coarse.curve.point(0.5),
+        ahead,
+        &world.network.params,
+    );
+    let middle = segment.curve.point(0.5);
+    let target = system.frame.to_sphere(middle);
+    let along = system
+        .frame
+        .to_sphere(middle + segment.curve.derivative(0.5).normalize() * ahead);
+    let back = (target - along).normalize();
+    // 0.03 radians of Appendix A's planet, at this planet's river scale.
+    let eye_dir = (target + back * 0.03 * APPENDIX_A_RADIUS * river_unit / r).normalize();
+    (
+        eye_dir * (r + height(eye_dir).max(world.planet.sea_level as f64) + 25.0 * river_unit),
+        target * (r + height(target)),
+    )
 }
 
 /// The direction of the highest point of the precomputed heights.
