@@ -332,9 +332,14 @@ impl Planet {
             };
 
             let t = Instant::now();
-            let heights =
+            let mut heights =
                 diamond_square(&base, &rule, base_level, precomputed_level, &mut progress);
             time("diamond-square", t);
+            if let Some(terrain) = &terrain {
+                let t = Instant::now();
+                terrain.add_detail(&base, &mut heights);
+                time("terrain file detail", t);
+            }
 
             let t = Instant::now();
             let (landmass, min_height, max_height) = measure(&heights, p.sea_level_height);

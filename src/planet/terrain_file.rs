@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::{cube::FACES, heights::FaceLattice};
 
@@ -283,6 +284,81 @@ impl TerrainFile {
                 }
             }
         }
+    }
+
+    /// The file's detail finer than the base lattice, into `fine` (diamond-square's refinement of the carved
+    /// `base`, `fine.cells` a power-of-two multiple of `base.cells`): where the file gives a point's height
+    /// (weight `w`, [`TerrainFile::weight_towards`]), the displacement of diamond-square's levels whose cells are at
+    /// least the file's pixels gives way to the file's own detail, the file's height less its bilinear
+    /// interpolation between the base lattice's points: `fine + w ((base bilinear - level bilinear) + (file -
+    /// file's base bilinear))`, with `level` the lattice of the finest such level (its points are `fine`'s at its
+    /// stride). The carved beds, everything the base lattice holds, and diamond-square's detail below the file's
+    /// pixels stay; a file no finer than the base lattice is left out.
+    pub fn add_detail(&self, base: &FaceLattice, fine: &mut FaceLattice) {
+        let (side, base_side) = (fine.side(), base.side());
+        let scale = fine.cells / base.cells;
+        // Levels below the base lattice whose cells the file's pixels resolve (cells of 90 / cells degrees).
+        let (dx, dy) = self.placement.degrees_per_pixel;
+        let base_cell = 90.0 / base.cells as f64;
+        let resolved =
+            ((base_cell / dx.max(dy)).log2().floor().max(0.0) as u32).min(scale.trailing_zeros());
+        if resolved == 0 {
+            return;
+        }
+        let stride = scale >> resolved;
+        let file_at_base: Vec<f64> = (0..FACES * base_side * base_side)
+            .into_par_iter()
+            .map(|k| {
+                let (face, rest) = (k / (base_side * base_side), k % (base_side * base_side));
+                let (i, j) = ((rest % base_side) as u32, (rest / base_side) as u32);
+                self.height_towards(base.direction(base.key(face, i, j)))
+            })
+            .collect();
+        let lattice = &*fine;
+        let detailed: Vec<f32> = (0..FACES * side * side)
+            .into_par_iter()
+            .map(|k| {
+                let (face, rest) = (k / (side * side), k % (side * side));
+                let (i, j) = ((rest % side) as u32, (rest / side) as u32);
+                let own = lattice.data[k] as f64;
+                let p = lattice.direction(lattice.key(face, i, j));
+                let weight = self.weight_towards(p);
+                if weight == 0.0 {
+                    return own as f32;
+                }
+                // The base cell holding the point, and where in it.
+                let (bi, bj) = (
+                    (i / scale).min(base.cells - 1),
+                    (j / scale).min(base.cells - 1),
+                );
+                let (fx, fy) = (
+                    (i - bi * scale) as f64 / scale as f64,
+                    (j - bj * scale) as f64 / scale as f64,
+                );
+                let bilinear = |at: &dyn Fn(u32, u32) -> f64| {
+                    let top = at(bi, bj) * (1.0 - fx) + at(bi + 1, bj) * fx;
+                    let bottom = at(bi, bj + 1) * (1.0 - fx) + at(bi + 1, bj + 1) * fx;
+                    top * (1.0 - fy) + bottom * fy
+                };
+                let carved = bilinear(&|i, j| base.get(face, i, j) as f64);
+                let file_coarse = bilinear(&|i, j| file_at_base[base.index(face, i, j)]);
+                let file_detail = self.height_towards(p) - file_coarse;
+                // The finest resolved level's lattice, bilinear at the point.
+                let (li, lj) = (
+                    (i / stride).min(fine.cells / stride - 1),
+                    (j / stride).min(fine.cells / stride - 1),
+                );
+                let (gx, gy) = (
+                    (i - li * stride) as f64 / stride as f64,
+                    (j - lj * stride) as f64 / stride as f64,
+                );
+                let at = |i: u32, j: u32| lattice.get(face, i * stride, j * stride) as f64;
+                let level = (at(li, lj) * (1.0 - gx) + at(li + 1, lj) * gx) * (1.0 - gy)
+                    + (at(li, lj + 1) * (1.0 - gx) + at(li + 1, lj + 1) * gx) * gy;
+                (own + weight * (carved - level + file_detail)) as f32
+            })
+            .collect();
+        fine.data = detailed;
     }
 
     /// How much of the height towards `p` the file gives: 1 on a whole planet and inside a region, falling
