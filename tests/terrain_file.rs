@@ -451,6 +451,29 @@ fn a_region_is_placed_on_the_procedural_planet() {
     ]);
     let file = TerrainFile::load(&region, (1.0, 0.0), 0.4, None).unwrap();
     assert!(file.is_region());
+    // The same region as a 16-bit PNG is placed by the JSON beside it, with the same heights within their step.
+    let png = dir.join("region.png");
+    succeeds(&[
+        "export",
+        "region",
+        "--seed",
+        "2",
+        "--bounds",
+        &bounds_text,
+        "--level",
+        "3",
+        "--format",
+        "png",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    let png = TerrainFile::load(&png, (1.0, 0.0), 0.4, None).unwrap();
+    assert!(png.is_region());
+    assert_eq!(png.bounds(), file.bounds());
+    let centre = direction_at(0.0, 2.5);
+    let (a, b) = (file.height_towards(centre), png.height_towards(centre));
+    // A 16-bit step of the region's 9.6 units of relief is 0.00015.
+    assert!((a - b).abs() < 1e-3, "{a} against {b}");
     let placed = file.bounds();
     assert!(
         placed

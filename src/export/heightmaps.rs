@@ -135,6 +135,13 @@ pub fn write_georeferenced(
     };
     let mut metadata = write_raster(path, &raster, format, metadata, Some(geo))?;
     let (dx, dy) = geo.degrees_per_pixel;
+    // Where the raster lies, for readers of a PNG or EXR (which carry no GeoTIFF tags): `<terrain-file>` reads it.
+    metadata["bounds"] = json!([
+        geo.west,
+        geo.north - dy * height as f64,
+        geo.west + dx * width as f64,
+        geo.north
+    ]);
     metadata["projection"] = json!(format!(
         "equirectangular: pixel (x, y) covers longitudes {} + x {dx} onwards (east positive, from +X towards -Z) \
          and latitudes {} - y {dy} downwards (north: +Y)",

@@ -143,8 +143,9 @@ impl TerrainFile {
     /// Reads `path` and checks it holds heights for every pixel. A PNG's 16-bit values become `height_offset +
     /// height_scale x value`, from the JSON beside it (`PATH.json`, as `export` writes) where there is one, else
     /// from `scale_offset`. The raster lies where `bounds` (`[west, south, east, north]` in degrees) says, else
-    /// where a TIFF's GeoTIFF tags say, else over the whole sphere if it is twice as wide as high; a whole planet
-    /// needs land and sea at `sea_level`.
+    /// where a TIFF's GeoTIFF tags say, else where the JSON beside it says (`bounds`, as `export` writes for a PNG
+    /// or EXR), else over the whole sphere if it is twice as wide as high; a whole planet needs land and sea at
+    /// `sea_level`.
     pub fn load(
         path: &Path,
         scale_offset: (f32, f32),
@@ -172,11 +173,14 @@ impl TerrainFile {
                 ))
             }
         };
-        let placement = match (bounds, tagged) {
-            (Some(bounds), _) => Placement::from_bounds(bounds, width, height),
-            (None, Some(tagged)) => tagged,
-            (None, None) if width == 2 * height => Placement::whole(width, height),
-            (None, None) => {
+        // The configuration's bounds, else the GeoTIFF tags, else the bounds in the JSON beside the file.
+        let beside = bounds_beside(path).map_err(unreadable)?;
+        let placement = match (bounds, tagged, beside) {
+            (Some(bounds), ..) => Placement::from_bounds(bounds, width, height),
+            (None, Some(tagged), _) => tagged,
+            (None, None, Some(bounds)) => Placement::from_bounds(bounds, width, height),
+            (None, None, None) if width == 2 * height => Placement::whole(width, height),
+            (None, None, None) => {
                 return Err(TerrainFileError::NoPlacement {
                     path: name,
                     width,
@@ -502,14 +506,43 @@ fn read_png(path: &Path, (scale, offset): (f32, f32)) -> Result<Heights, String>
     Ok((width, height, heights))
 }
 
-/// `height_scale` and `height_offset` from the JSON `export` writes beside a raster, if there is one.
-fn scale_offset_beside(path: &Path) -> Result<Option<(f32, f32)>, String> {
+/// `bounds` (`[west, south, east, north]` in degrees) from the JSON `export` writes beside a raster, if it has
+/// them.
+fn bounds_beside(path: &Path) -> Result<Option<[f64; 4]>, String> {
+    let Some((value, beside)) = json_beside(path)? else {
+        return Ok(None);
+    };
+    let Some(bounds) = value.get("bounds") else {
+        return Ok(None);
+    };
+    let numbers: Option<Vec<f64>> = bounds
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_f64()).collect());
+    match numbers.as_deref() {
+        Some(&[west, south, east, north]) => Ok(Some([west, south, east, north])),
+        _ => Err(format!(
+            "{} beside it has bounds {bounds} where four numbers [west, south, east, north] belong",
+            beside.display()
+        )),
+    }
+}
+
+/// The JSON `export` writes beside a raster (`PATH.json`), and its path, if there is one.
+fn json_beside(path: &Path) -> Result<Option<(serde_json::Value, std::path::PathBuf)>, String> {
     let beside = path.with_extension("json");
     let Ok(text) = std::fs::read_to_string(&beside) else {
         return Ok(None);
     };
-    let value: serde_json::Value = serde_json::from_str(&text)
+    let value = serde_json::from_str(&text)
         .map_err(|e| format!("{} beside it is not JSON: {e}", beside.display()))?;
+    Ok(Some((value, beside)))
+}
+
+/// `height_scale` and `height_offset` from the JSON `export` writes beside a raster, if there is one.
+fn scale_offset_beside(path: &Path) -> Result<Option<(f32, f32)>, String> {
+    let Some((value, beside)) = json_beside(path)? else {
+        return Ok(None);
+    };
     let number = |key: &str| {
         value[key].as_f64().map(|v| v as f32).ok_or_else(|| {
             format!(
