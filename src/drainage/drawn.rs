@@ -15,9 +15,11 @@ use super::{
 pub struct DrawnMeasures {
     /// Reaches between junctions: the drawn reaches cut where streams join them.
     pub reaches: usize,
+    /// The highest Strahler order drawn.
     pub strahler_max: u32,
     /// Strahler streams of each order (index 0: order 1) in the basins of order 3 and more.
     pub streams_per_order: Vec<usize>,
+    /// Horton's bifurcation ratio of the drawn network (as [`super::rivers::DrainageMeasures::bifurcation_ratio`]).
     pub bifurcation_ratio: f64,
 }
 

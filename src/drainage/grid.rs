@@ -16,6 +16,7 @@ use crate::planet::{
 
 /// Lattice points of the sphere and their neighbours.
 pub struct SphereGrid {
+    /// Cells per face edge of the lattice the grid was made from.
     pub cells: u32,
     /// Unit direction of each node.
     pub directions: Vec<DVec3>,
@@ -104,10 +105,12 @@ impl SphereGrid {
         }
     }
 
+    /// Nodes in the grid (lattice points shared by faces counted once).
     pub fn len(&self) -> usize {
         self.directions.len()
     }
 
+    /// Whether the grid has no node.
     pub fn is_empty(&self) -> bool {
         self.directions.is_empty()
     }
@@ -117,6 +120,7 @@ impl SphereGrid {
         self.node_of[lattice.index(face, i, j)]
     }
 
+    /// The nodes beside `node`: its eight lattice neighbours (seven at a cube corner), across face edges.
     pub fn neighbours(&self, node: u32) -> &[u32] {
         let k = node as usize;
         &self.neighbours[self.offsets[k] as usize..self.offsets[k + 1] as usize]

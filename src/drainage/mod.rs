@@ -27,9 +27,13 @@ use routing::route;
 /// drainage area (world units squared) at each.
 #[derive(Clone, Debug)]
 pub struct ReachPath {
+    /// Unit directions, upstream first.
     pub points: Vec<DVec3>,
+    /// The bed height at each point, never rising downstream.
     pub beds: Vec<f32>,
+    /// The drainage area at each point, world units squared.
     pub areas: Vec<f64>,
+    /// Strahler order of the reach.
     pub strahler: u32,
     /// The reach this one flows into (an index into [`Drainage::reaches`]); `None` at a mouth.
     pub downstream: Option<usize>,
@@ -38,8 +42,10 @@ pub struct ReachPath {
 /// A lake: the directions of its nodes and its water level.
 #[derive(Clone, Debug, Serialize)]
 pub struct LakeShape {
+    /// Unit directions of the lake's lattice nodes.
     #[serde(skip)]
     pub points: Vec<DVec3>,
+    /// The water level (the spill height of its depression).
     pub level: f32,
     /// Area on the sphere, world units squared.
     pub area: f64,
@@ -48,8 +54,11 @@ pub struct LakeShape {
 /// The drained planet: its reaches, lakes and measures.
 #[derive(Clone, Debug, Default)]
 pub struct Drainage {
+    /// Every reach; a reach comes after every reach that flows into it.
     pub reaches: Vec<ReachPath>,
+    /// Depressions deep enough to hold water.
     pub lakes: Vec<LakeShape>,
+    /// The network's statistics (stats.json, docs/geomorphology.md).
     pub measures: DrainageMeasures,
     /// The largest drainage area of any river node (world units squared): widths scale against it.
     pub largest_area: f64,

@@ -25,6 +25,7 @@ pub struct Reach {
 /// A depression deep enough to hold water.
 #[derive(Clone, Debug)]
 pub struct Lake {
+    /// The grid nodes under its water.
     pub nodes: Vec<u32>,
     /// The water level: the depression's spill height.
     pub level: f64,
@@ -35,12 +36,16 @@ pub struct Lake {
 pub struct DrainageMeasures {
     /// River systems: reaches that end at a mouth.
     pub rivers: usize,
+    /// Stretches between heads, confluences and mouths.
     pub reaches: usize,
+    /// River nodes where two rivers or more meet.
     pub confluences: usize,
     /// Confluences where three rivers or more meet (D8 lets up to seven drain into one node; real junctions are
     /// binary): wide rivers meeting at one point are drawn as one blob of water (docs/geomorphology.md).
     pub multiple_junctions: usize,
+    /// Depressions kept as lakes.
     pub lakes: usize,
+    /// The highest Strahler order.
     pub strahler_max: u32,
     /// Strahler streams of each order (index 0: order 1) in the basins of order [`HORTON_BASIN_ORDER`] and more.
     pub streams_per_order: Vec<usize>,
@@ -63,10 +68,13 @@ pub const HORTON_BASIN_ORDER: u32 = 3;
 
 /// What the routing makes of a planet's heights.
 pub struct DrainageNetwork {
+    /// Every reach, upstream first.
     pub reaches: Vec<Reach>,
+    /// The lakes.
     pub lakes: Vec<Lake>,
     /// Per node: the lake it belongs to.
     pub lake_of: Vec<Option<u32>>,
+    /// The network's statistics.
     pub measures: DrainageMeasures,
 }
 
@@ -333,6 +341,7 @@ pub struct Ordering {
     /// Per reach: 1 from a head, the larger of the joining orders below a confluence, plus one when two of the
     /// largest meet.
     pub strahler: Vec<u32>,
+    /// The highest of them.
     pub strahler_max: u32,
     /// Strahler streams of each order (index 0: order 1) in the basins of order [`HORTON_BASIN_ORDER`] and more.
     pub streams_per_order: Vec<usize>,

@@ -21,8 +21,9 @@ pub struct Routing {
     /// Drainage area on the unit sphere: a node's own area plus the area of everything that drains through it.
     pub area: Vec<f64>,
     /// Quads of the lattice where two diagonal flows would have crossed and one was turned (see
-    /// `uncross_diagonals`), and those where no lower alternative existed.
+    /// `uncross_diagonals`).
     pub turned: usize,
+    /// Quads where two diagonal flows still cross: no lower alternative was left.
     pub crossing: usize,
 }
 

@@ -51,11 +51,13 @@ impl Hasher for CellHasher {
 /// A point of a drawn course.
 #[derive(Clone, Copy)]
 pub struct Course {
+    /// Unit direction.
     pub point: DVec3,
     /// The bed's height, or a lake's level.
     pub height: f32,
     /// Half the river's width (radians; 0 for a lake).
     pub half_width: f64,
+    /// Whether the point lies on a lake rather than a river.
     pub lake: bool,
     /// Where on the reaches added this point lies (none on a lake).
     pub junction: Option<Junction>,

@@ -14,33 +14,54 @@ use super::{cube::FACES, heights::FaceLattice};
 /// Why a terrain file cannot be used; each names the file and what a usable one needs.
 #[derive(Debug, thiserror::Error)]
 pub enum TerrainFileError {
+    /// The file is missing, of another format, or its decoder failed.
     #[error("cannot read terrain-file {path}: {message}")]
-    Unreadable { path: String, message: String },
+    Unreadable {
+        /// The file.
+        path: String,
+        /// What went wrong, and what a usable file is.
+        message: String,
+    },
     #[error(
         "terrain-file {path} is {width}x{height}; a whole planet's equirectangular raster must be twice as wide as \
          high (e.g. 2048x1024) and at least 8x4"
     )]
+    /// Too small, or a whole planet not twice as wide as high.
     WrongSize {
+        /// The file.
         path: String,
+        /// Its pixels across.
         width: u32,
+        /// Its pixels down.
         height: u32,
     },
     #[error("terrain-file {path} has no height at pixel ({x}, {y}) (the value is {value}): every pixel needs one")]
+    /// A pixel holds NaN or an infinity.
     NotFinite {
+        /// The file.
         path: String,
+        /// The pixel's column.
         x: u32,
+        /// The pixel's row.
         y: u32,
+        /// What it holds.
         value: f32,
     },
     #[error(
         "terrain-file {path} is all {what} at sea-level-height {sea_level} (heights {lowest} to {highest}); a \
          whole planet needs land and sea"
     )]
+    /// A whole planet all land or all sea.
     Uniform {
+        /// The file.
         path: String,
+        /// "land" or "sea".
         what: &'static str,
+        /// The configuration's sea level.
         sea_level: f32,
+        /// The file's lowest height.
         lowest: f32,
+        /// The file's highest height.
         highest: f32,
     },
     #[error(
@@ -48,21 +69,34 @@ pub enum TerrainFileError {
          (ModelTiepoint and ModelPixelScale in degrees, as `export region` writes) or <terrain-bounds>, and a whole \
          planet's raster must be twice as wide as high"
     )]
+    /// Neither a georeference nor a whole planet's shape.
     NoPlacement {
+        /// The file.
         path: String,
+        /// Its pixels across.
         width: u32,
+        /// Its pixels down.
         height: u32,
     },
+    /// A georeference the planet cannot use (projected, other units, out of range, too small a region).
     #[error("terrain-file {path}: {message}")]
-    BadPlacement { path: String, message: String },
+    BadPlacement {
+        /// The file.
+        path: String,
+        /// Why, and what would do.
+        message: String,
+    },
 }
 
 /// Where a raster lies on the planet: the longitude of its west edge, the latitude of its north edge (degrees) and
 /// the degrees each pixel spans along longitude and latitude (pixels as areas, row 0 in the north).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
+    /// Longitude of the west edge, degrees.
     pub west: f64,
+    /// Latitude of the north edge, degrees.
     pub north: f64,
+    /// Degrees a pixel spans along longitude and latitude.
     pub degrees_per_pixel: (f64, f64),
 }
 
