@@ -18,17 +18,40 @@ pub use read::elements;
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     // The reason is in the message, not a source: printed with its chain, it appeared twice.
+    /// The file cannot be read.
     #[error("cannot read configuration file {path}: {reason}")]
-    Read { path: String, reason: String },
+    Read {
+        /// The file.
+        path: String,
+        /// The operating system's reason.
+        reason: String,
+    },
+    /// The file is not well-formed XML.
     #[error("{path}: malformed configuration XML: {message}")]
-    Xml { path: String, message: String },
+    Xml {
+        /// The file.
+        path: String,
+        /// The parser's message, with the position.
+        message: String,
+    },
+    /// An element no section has.
     #[error("{path}: unknown element {detail}")]
-    UnknownElement { path: String, detail: String },
+    UnknownElement {
+        /// The file.
+        path: String,
+        /// The element, its section, and the names that section has.
+        detail: String,
+    },
+    /// A value out of its range or of the wrong kind.
     #[error("{path}: <{element}> = '{value}' is invalid: {expected}")]
     Value {
+        /// The file.
         path: String,
+        /// The element.
         element: String,
+        /// What the file says.
         value: String,
+        /// The valid range or names.
         expected: String,
     },
 }
@@ -39,14 +62,21 @@ pub const MAX_LATTICE_CELLS: u32 = 1 << 30;
 /// `<planet-attributes>`: Table 6.1 plus the base-terrain parameters of Chapter 4.
 #[derive(Clone, Debug, Serialize)]
 pub struct PlanetConfig {
+    /// The sphere's radius, in the configuration's length unit (Table 6.1).
     pub radius: f32,
+    /// Continents of the Voronoi continent map (4.1).
     pub continents: u32,
+    /// The share of the surface above sea level, in percent (4.1; corrected after diamond-square).
     pub landmass_percentage: f32,
+    /// The sea's height above the sphere.
     pub sea_level_height: f32,
+    /// The highest mountain's height (4.2); the relief scale of the drainage model.
     pub max_mountain_height: f32,
+    /// The atmosphere shell's thickness (beyond the thesis: docs/atmosphere.md).
     pub atmosphere_height: f32,
     /// `-1` in the file: pick a seed at start (logged). Resolved by [`Config::resolve_seed`].
     pub master_seed: i64,
+    /// Continents from `continents_image` instead of the Voronoi map (Appendix A).
     pub continents_from_file: bool,
     /// Image read when `continents_from_file` is true (equirectangular, land bright / sea dark); in a file,
     /// relative to the file's folder (the default, config/continents.png, to the working folder).
@@ -86,6 +116,7 @@ pub struct PlanetConfig {
     /// A 16-bit PNG terrain's heights: `terrain-height-offset + terrain-height-scale x value`, where no JSON
     /// beside the file gives them.
     pub terrain_height_scale: f32,
+    /// See `terrain_height_scale`.
     pub terrain_height_offset: f32,
 }
 
@@ -153,17 +184,25 @@ impl crate::named::Named for RiverModel {
 /// `<river-attributes>`: Table 6.1 plus the river-generation parameters of Chapter 5.
 #[derive(Clone, Debug, Serialize)]
 pub struct RiverConfig {
+    /// The thesis's random-walk rivers, or the drainage network (the default).
     pub model: RiverModel,
     /// Drainage model: the drainage area (world units squared) at which a river begins.
     pub source_area: f32,
     /// Drainage model: how deep a depression must be (height units) to be kept as a lake.
     pub lake_depth: f32,
+    /// How far from a river its samples shape the terrain (Table 6.1, Procedure 3).
     pub influence_distance: f32,
+    /// The depth of the river basins (Procedure 5).
     pub basin_depth: f32,
+    /// How far the water surface lies below the basin's top (Procedure 5).
     pub basin_water_offset: f32,
+    /// A river's width at its source (5.1).
     pub starting_width: f32,
+    /// The narrowest river drawn (tributaries and finer streams).
     pub min_width: f32,
+    /// The width at the mouth, as a multiple of the starting width (5.1).
     pub ending_factor: f32,
+    /// Segments per subdivision (5.2.1).
     pub segments: u32,
     /// Subdivision levels included in each river's convex hull (5.2.3: the thesis uses 3).
     pub hull_levels: u32,
@@ -223,9 +262,13 @@ impl crate::named::Named for LodRule {
 /// `<rendering-attributes>`: Table 6.1 plus the run-time budgets.
 #[derive(Clone, Debug, Serialize)]
 pub struct RenderingConfig {
+    /// Vertices per patch edge, 2^n + 1 (Table 6.1).
     pub vertices: u32,
+    /// The deepest level of detail drawn.
     pub max_level_of_detail: u32,
+    /// The switchFactor of Eq. 6.1 (the distance rule).
     pub level_of_detail_switch_factor: f32,
+    /// The thesis's distance rule (Eq. 6.1) or the screen-space-error rule (beyond the thesis).
     pub level_of_detail_rule: LodRule,
     /// Screen-space-error rule: the geometric error, in pixels, a patch may show before it is refined.
     pub pixel_error: f32,
@@ -244,10 +287,14 @@ pub struct RenderingConfig {
     pub resident_memory_mb: u32,
 }
 
+/// A whole configuration: the three sections of Table 6.1.
 #[derive(Clone, Debug, Serialize)]
 pub struct Config {
+    /// `<planet-attributes>`.
     pub planet: PlanetConfig,
+    /// `<river-attributes>`.
     pub river: RiverConfig,
+    /// `<rendering-attributes>`.
     pub rendering: RenderingConfig,
 }
 
