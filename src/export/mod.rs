@@ -19,10 +19,17 @@ use crate::planet::{
     Planet,
 };
 
+/// Why an export could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
+    /// Writing a file failed (nothing half-written is left).
     #[error("cannot write {path}: {message}")]
-    Write { path: String, message: String },
+    Write {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// Terrain colour for a height (sea by depth, then sand, grass, rock, snow).

@@ -28,6 +28,7 @@ pub enum RasterFormat {
 }
 
 impl RasterFormat {
+    /// The format `--format` names, or what the names are.
     pub fn parse(text: &str) -> Result<Self, String> {
         match text {
             "tiff" | "tif" => Ok(Self::Tiff),
@@ -48,6 +49,7 @@ impl RasterFormat {
         }
     }
 
+    /// The file extension it writes.
     pub fn extension(self) -> &'static str {
         match self {
             Self::Tiff => "tif",
@@ -72,9 +74,13 @@ impl RasterFormat {
 /// A row-major grid of heights, row 0 at the top, and the range a PNG maps to 0..65535 (the grid's own, or a
 /// wider one shared by several rasters, so that their values compare).
 pub struct Raster<'a> {
+    /// Pixels across.
     pub width: u32,
+    /// Pixels down.
     pub height: u32,
+    /// One height per pixel.
     pub heights: &'a [f32],
+    /// The lowest and highest height a PNG maps to 0 and 65535.
     pub range: (f32, f32),
 }
 
@@ -92,9 +98,13 @@ pub fn height_range(heights: &[f32]) -> (f32, f32) {
 /// Where a longitude-latitude raster lies: its top-left corner and pixel size in degrees, on a sphere of
 /// `radius` (GeoTIFF: geographic model, pixels as areas, a user-defined sphere).
 pub struct Georeference {
+    /// Longitude of the west edge.
     pub west: f64,
+    /// Latitude of the north edge.
     pub north: f64,
+    /// Degrees a pixel spans along longitude and latitude.
     pub degrees_per_pixel: (f64, f64),
+    /// The sphere's radius.
     pub radius: f64,
 }
 

@@ -19,10 +19,15 @@ pub const MAX_REGION_PIXELS: u64 = 1 << 24;
 /// A window west..east, south..north (degrees) split into `size` pixels of equal angle, sampled at their centres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Region {
+    /// Longitude of the west edge.
     pub west: f64,
+    /// Latitude of the south edge.
     pub south: f64,
+    /// Longitude of the east edge.
     pub east: f64,
+    /// Latitude of the north edge.
     pub north: f64,
+    /// Pixels across and down.
     pub size: (u32, u32),
 }
 
@@ -77,6 +82,7 @@ impl Region {
         )
     }
 
+    /// Its GeoTIFF georeference on a sphere of `radius`.
     pub fn georeference(&self, radius: f64) -> Georeference {
         Georeference {
             west: self.west,
@@ -90,8 +96,11 @@ impl Region {
 /// A region's surface, row by row from the north-west: terrain heights (river beds carved in), water heights, and
 /// how far inside a river's basin each sample lies ([`CarvedPatch::basin`]).
 pub struct RegionSurface {
+    /// Terrain heights with the river beds carved in.
     pub terrain: Vec<f32>,
+    /// Water heights.
     pub water: Vec<f32>,
+    /// How far inside a river's basin each sample lies.
     pub basin: Vec<f32>,
 }
 

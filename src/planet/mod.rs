@@ -61,33 +61,50 @@ pub fn direction_at(lon: f64, lat: f64) -> DVec3 {
 /// Problems generating a planet.
 #[derive(Debug, thiserror::Error)]
 pub enum PlanetError {
+    /// The continents image cannot be used.
     #[error(transparent)]
     Continents(#[from] ContinentError),
+    /// The terrain file cannot be used.
     #[error(transparent)]
     TerrainFile(#[from] TerrainFileError),
+    /// The base lattice does not fit the patch levels.
     #[error("base-resolution {base} {rule}")]
-    BaseResolution { base: u32, rule: String },
+    BaseResolution {
+        /// The configuration's `base-resolution`.
+        base: u32,
+        /// What it must be.
+        rule: String,
+    },
 }
 
 /// What `generate` reports.
 #[derive(Clone, Debug, Serialize)]
 pub struct PlanetStats {
+    /// The master seed the planet was made from.
     pub seed: u32,
     /// Share of the sphere's area above sea level on the precomputed lattice, in percent.
     pub landmass_percent: f64,
     /// Share of the sphere's area that the continents (Voronoi or image, after perturbation) cover, in percent.
     pub continent_percent: f64,
+    /// Continents of the Voronoi map (0 when they come from an image or a terrain file).
     pub continents: usize,
+    /// Mountains seeded (the thesis's relief; 0 otherwise).
     pub mountains: usize,
+    /// The Voronoi weight that gave the landmass share (4.1), after the corrections.
     pub continental_weight: f64,
+    /// The lowest height of the precomputed lattice.
     pub min_height: f32,
+    /// The highest height of the precomputed lattice.
     pub max_height: f32,
+    /// The patch level whose vertices are the base lattice's points.
     pub base_level: u32,
     /// The level of the precomputed lattice (`memory_bytes`); finer levels are generated per patch on demand.
     pub precomputed_level: u32,
+    /// Cells per face edge of the precomputed lattice.
     pub precomputed_cells: u32,
     /// Milliseconds per stage (summed over the landmass corrections).
     pub timings_ms: std::collections::BTreeMap<String, f64>,
+    /// Bytes of the precomputed lattice.
     pub memory_bytes: u64,
     /// Geomorphology's measures of the planet's form (docs/geomorphology.md).
     #[serde(flatten)]
@@ -100,13 +117,17 @@ pub struct PlanetStats {
 /// A generated planet: its precomputed coarse heights, the rule that refines them to any level, and its
 /// mountains.
 pub struct Planet {
+    /// The sphere's radius.
     pub radius: f64,
+    /// The sea's height above the sphere.
     pub sea_level: f32,
     /// Vertices per patch edge (33).
     pub vertices: u32,
+    /// The deepest level of detail drawn.
     pub max_level: u32,
     /// The heights of level `precomputed_level` (every coarser level is a sub-sampling of it).
     pub lattice: FaceLattice,
+    /// The level `lattice` holds.
     pub precomputed_level: u32,
     /// The diamond-square rule of every finer level.
     pub rule: DetailRule,
@@ -116,10 +137,13 @@ pub struct Planet {
     /// Per level 1..=precomputed_level (index level - 1), per patch: how far the precomputed lattice stands from
     /// its parent's bilinear surface over the patch at most (`FaceLattice::quadrant_deviations`).
     quadrant_deviations: Vec<Vec<f32>>,
+    /// The thesis's mountains (4.2; empty with the drainage model).
     pub mountains: Vec<Mountain>,
+    /// The Voronoi continents' feature points (`None` when the continents come from an image or a file).
     pub features: Option<FeaturePoints>,
     /// The rivers and lakes of the drainage model (`None` for the thesis's model).
     pub drainage: Option<Drainage>,
+    /// What `generate` reports.
     pub stats: PlanetStats,
 }
 
