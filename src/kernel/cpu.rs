@@ -16,12 +16,19 @@ use super::{vertex_position, KernelParams, ParentQuadrant, PatchJob, RiverSample
 /// What Procedure 3 returns for a relevant sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampleContribution {
+    /// The sample's bed height (Procedure 3's `height`).
     pub height: f32,
+    /// The distance weight `w_dist`: 1 at the sample, 0 at its influence distance.
     pub w_dist: f32,
+    /// The basin depth at the vertex from this sample.
     pub basin_depth: f32,
+    /// The sample's half width.
     pub river_width: f32,
+    /// Whether the vertex lies within the sample's river.
     pub in_river: bool,
+    /// The river's depth at the vertex (`inRiverDepth`).
     pub in_river_depth: f32,
+    /// The weight of that depth (`w_river`).
     pub w_river: f32,
     /// Distance to the sample, negated when the vertex lies left of the sample's direction.
     pub dist: f32,
@@ -118,13 +125,21 @@ pub fn calculate_height_by_sample(
 /// The accumulators of Procedure 4.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Accumulators {
+    /// Sum of `w_dist`-weighted bed heights.
     pub height_sum: f32,
+    /// Sum of `w_dist`.
     pub weight_sum: f32,
+    /// Sum of `w_dist`-weighted basin depths.
     pub basin_sum: f32,
+    /// Sum of `w_dist`-weighted half widths.
     pub width_sum: f32,
+    /// Whether any sample's river covers the vertex.
     pub in_river: bool,
+    /// Sum of `w_river`-weighted river depths.
     pub in_river_sum: f32,
+    /// Sum of `w_river`.
     pub in_river_w_sum: f32,
+    /// The signed distance to the nearest sample.
     pub min_distance: f32,
     /// The square of `min_distance`.
     pub min_distance2: f32,
@@ -138,6 +153,7 @@ pub struct Accumulators {
     /// Beyond the thesis: how far into that lake's reach the vertex lies from the lake's nearest sample, as the
     /// squared share of the reach (0 on the lake's line, towards 1 at the reach's edge).
     pub lake_offset2: f32,
+    /// Beyond the thesis: sum of `w_river`-weighted downstream directions (the water's flow).
     pub flow_sum: [f32; 2],
 }
 

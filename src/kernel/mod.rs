@@ -16,13 +16,18 @@ pub use crate::shader_types::RiverSample;
 /// The constants of Procedures 3-5, from the configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct KernelParams {
+    /// How far a sample reaches (Procedure 3).
     pub influence_distance: f32,
+    /// The depth of the river basins (Procedure 5).
     pub basin_depth: f32,
+    /// The sea's height: water never stands below it.
     pub sea_level: f32,
+    /// How far the water surface lies below the basin's top (Procedure 5).
     pub basin_water_offset: f32,
 }
 
 impl KernelParams {
+    /// The constants of `config`.
     pub fn from_config(config: &crate::config::Config) -> Self {
         Self {
             influence_distance: config.river.influence_distance,
@@ -37,10 +42,15 @@ impl KernelParams {
 /// accumulates it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RiverTexel {
+    /// The river terrain's height (the carved bed and banks).
     pub terrain_height: f32,
+    /// How much of the base terrain shows: 0 in a river, 1 beyond every river's influence (Section 8.2).
     pub lerp_factor: f32,
+    /// The water surface's height.
     pub water_height: f32,
+    /// The signed distance to the nearest river sample (Procedure 3).
     pub min_distance: f32,
+    /// The weighted half width.
     pub river_width: f32,
     /// Beyond the thesis: the water's flow, the mean of the unit directions (downstream, in the patch frame) of
     /// the samples whose river covers the vertex, weighted as in the river depth (`w_river`); shorter than 1
@@ -51,7 +61,9 @@ pub struct RiverTexel {
 /// The work for one patch: the grid spacing and the samples that influence it.
 #[derive(Clone, Copy, Debug)]
 pub struct PatchJob<'a> {
+    /// World units between neighbouring vertices.
     pub spacing: f32,
+    /// The samples whose influence reaches the patch.
     pub samples: &'a [RiverSample],
 }
 
@@ -62,6 +74,7 @@ pub struct PatchJob<'a> {
 /// three quarters of the vertices need the kernel (docs/kernel.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ParentQuadrant {
+    /// The parent's vertex under the child's vertex (0, 0).
     pub offset: [u32; 2],
 }
 
@@ -130,11 +143,17 @@ impl RiverTexel {
 /// vertex, and both values (so a mismatch on one device can be traced to its case).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct OutputDiff {
+    /// Which output ([`RiverTexel`]'s field name).
     pub output: &'static str,
+    /// The largest absolute difference.
     pub max_abs_diff: f32,
+    /// The patch where it is.
     pub patch: usize,
+    /// The vertex where it is.
     pub vertex: [u32; 2],
+    /// The reference's value there.
     pub expected: f32,
+    /// The compared value there.
     pub actual: f32,
 }
 

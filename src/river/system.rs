@@ -43,13 +43,18 @@ pub const MAX_DEPTH: u32 = 12;
 /// A river system's 2D frame (see the module documentation).
 #[derive(Clone, Copy, Debug)]
 pub struct RiverFrame {
+    /// The unit direction the frame is centred on (the tangent plane touches the sphere there).
     pub centre: DVec3,
+    /// The frame's first axis in the tangent plane.
     pub e1: DVec3,
+    /// The frame's second axis (`centre x e1`).
     pub e2: DVec3,
+    /// The planet's radius: frame coordinates are world units.
     pub radius: f64,
 }
 
 impl RiverFrame {
+    /// The frame at `centre` whose first axis points towards `towards`, on a sphere of `radius`.
     pub fn new(centre: DVec3, towards: DVec3, radius: f64) -> Self {
         let e1 = (towards - centre * towards.dot(centre)).normalize();
         Self {
@@ -79,16 +84,21 @@ impl RiverFrame {
 /// full width at both ends (linear in between, 5.1).
 #[derive(Clone, Copy, Debug)]
 pub struct Segment {
+    /// The course in the system's frame.
     pub curve: Hermite,
+    /// The bed height at the start and at the end.
     pub heights: (f32, f32),
+    /// The full width at the start and at the end.
     pub widths: (f32, f32),
     /// Identity of this piece (a hash of its path from the initial segment): all its randomness derives from it.
     pub key: u64,
+    /// Subdivision depth (0: an initial segment).
     pub depth: u32,
     /// 0 for the main river, 1 for its tributaries, 2 for theirs.
     pub generation: u32,
     /// Key of the branch (main river or tributary) this piece belongs to, and of the branch it flows into.
     pub branch: u64,
+    /// See `branch` (`None` for a main river).
     pub parent_branch: Option<u64>,
     /// A lake's piece (beyond the thesis, docs/rivers.md): its height is the lake's water level, and its samples
     /// put that level on the vertices within half its width, where the terrain below it is drawn under water.
@@ -96,20 +106,22 @@ pub struct Segment {
 }
 
 impl Segment {
+    /// The bed height at curve parameter `t` (linear between the ends, 5.1).
     pub fn height_at(&self, t: f64) -> f32 {
         self.heights.0 + (self.heights.1 - self.heights.0) * t as f32
     }
 
+    /// The full width at curve parameter `t` (linear between the ends, 5.1).
     pub fn width_at(&self, t: f64) -> f32 {
         self.widths.0 + (self.widths.1 - self.widths.0) * t as f32
     }
 
-    /// Length of the Bézier control polygon (at least the curve's length).
     /// The smaller of the widths at the two ends.
     pub fn narrowest(&self) -> f64 {
         self.widths.0.min(self.widths.1) as f64
     }
 
+    /// Length of the Bézier control polygon (at least the curve's length).
     pub fn polygon_length(&self) -> f64 {
         let c = self.curve.control_points();
         c[0].distance(c[1]) + c[1].distance(c[2]) + c[2].distance(c[3])
@@ -119,10 +131,15 @@ impl Segment {
 /// The parameters of subdivision, from the configuration.
 #[derive(Clone, Copy, Debug)]
 pub struct SubdivisionParams {
+    /// The planet's master seed: every piece's randomness derives from it and the piece's key.
     pub seed: u64,
+    /// Pieces a segment is split into (`segments`).
     pub pieces: u32,
+    /// How far an inner knot moves at most, times the segment's length over `pieces` (5.2.2).
     pub displacement: f64,
+    /// Probability that a segment spawns a tributary (5.2.3).
     pub tributary_probability: f64,
+    /// The narrowest river drawn.
     pub min_width: f32,
     /// Beyond the thesis: with the drainage model on eroded relief, the planet's relief over its radius, against
     /// which a piece's slope sets the swing of the meanders it gets when it is first short enough to hold them
@@ -131,6 +148,7 @@ pub struct SubdivisionParams {
 }
 
 impl SubdivisionParams {
+    /// The parameters of `config` for the planet of `seed`.
     pub fn from_config(config: &Config, seed: u64) -> Self {
         Self {
             seed,
@@ -385,7 +403,9 @@ impl ValleyLine {
 /// A river from a mountain to the sea with all its tributaries.
 #[derive(Clone, Debug)]
 pub struct RiverSystem {
+    /// Its index among the planet's systems (its randomness derives from it).
     pub id: u32,
+    /// The 2D frame its curves live in.
     pub frame: RiverFrame,
     /// The initial segments (5.2.1), depth 0.
     pub segments: Vec<Segment>,
@@ -393,7 +413,9 @@ pub struct RiverSystem {
     pub hull: Vec<DVec2>,
     /// The hull grown by the influence distance and by how far deeper levels can stray (6.3).
     pub extended: Vec<DVec2>,
+    /// Unit direction of its main river's source.
     pub source: DVec3,
+    /// Unit direction of its main river's mouth.
     pub mouth: DVec3,
     /// Angular radius around `frame.centre` that contains the extended hull.
     pub cap_angle: f64,
@@ -452,6 +474,7 @@ pub fn finest_piece_near(
 pub struct StreamLevel {
     /// The patch level from which they are drawn.
     pub level: u32,
+    /// The streams, as river systems.
     pub systems: Vec<RiverSystem>,
     /// Reaches (from a head or confluence to the next confluence, course or the sea).
     pub reaches: usize,
