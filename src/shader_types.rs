@@ -15,13 +15,18 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RiverSample {
+    /// Position in the patch frame.
     pub position: [f32; 2],
+    /// The curve's first derivative there (its direction downstream).
     pub derivative: [f32; 2],
+    /// The river-bed height (a lake's water level).
     pub height: f32,
+    /// The full width (negative for a lake's sample).
     pub width: f32,
     /// Beyond the thesis: the sample's own influence distance (0: the kernel's `influence-distance`, which bounds
     /// it). The streams of finer levels reach less far, so the thousands of them do not flatten the hills between.
     pub reach: f32,
+    /// Padding to two vec4s.
     pub _pad: f32,
 }
 
@@ -29,6 +34,7 @@ const _: () = assert!(size_of::<RiverSample>() == 32);
 const _: () = assert!(offset_of!(RiverSample, height) == 16);
 
 impl RiverSample {
+    /// A sample reaching as far as the kernel's influence distance.
     pub fn new(position: [f32; 2], derivative: [f32; 2], height: f32, width: f32) -> Self {
         Self {
             position,
@@ -51,9 +57,13 @@ impl RiverSample {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuPatchJob {
+    /// World units between neighbouring vertices.
     pub spacing: f32,
+    /// The patch's first sample in the sample buffer.
     pub sample_offset: u32,
+    /// Its samples.
     pub sample_count: u32,
+    /// The bindless slot of the patch's river texture.
     pub slot: u32,
     /// Mask words of the rows before this one: the tiled kernel's reach masks of this row start there.
     pub mask_offset: u32,
@@ -73,11 +83,17 @@ const _: () = assert!(offset_of!(GpuPatchJob, parent_offset) == 28);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct KernelPush {
+    /// [`crate::kernel::KernelParams::influence_distance`].
     pub influence_distance: f32,
+    /// [`crate::kernel::KernelParams::basin_depth`].
     pub basin_depth: f32,
+    /// [`crate::kernel::KernelParams::sea_level`].
     pub sea_level: f32,
+    /// [`crate::kernel::KernelParams::basin_water_offset`].
     pub basin_water_offset: f32,
+    /// Vertices per patch edge.
     pub grid_size: u32,
+    /// The job-table row that workgroup index 0 computes (rows are dispatched in groups of one lattice).
     pub first_job: u32,
 }
 
@@ -88,10 +104,15 @@ const _: () = assert!(offset_of!(KernelPush, grid_size) == 16);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct TiledConstants {
+    /// Invocations per workgroup: `block_x` x `block_y`, a multiple of the subgroup size.
     pub invocations: u32,
+    /// The vertex block's width (a power of two).
     pub block_x: u32,
+    /// The vertex block's height (a power of two, `block_x` or half of it).
     pub block_y: u32,
+    /// Samples per tile: a multiple of 32, at most 32 x the invocations.
     pub tile_size: u32,
+    /// The subgroup size the pipeline requires.
     pub subgroup_size: u32,
 }
 
@@ -101,16 +122,21 @@ const _: () = assert!(size_of::<TiledConstants>() == 20);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuRefineJob {
+    /// The bindless slot the child's heights go to.
     pub child_slot: i32,
+    /// The bindless slot of the parent's heights.
     pub parent_slot: i32,
+    /// The cube face.
     pub face: i32,
     /// The child's level.
     pub level: i32,
     /// The child's position in its level's grid.
     pub x: i32,
+    /// See `x`.
     pub y: i32,
     /// Where the child's lowest and highest height go in the ranges buffer.
     pub range_index: i32,
+    /// Padding to 32 bytes.
     pub unused: i32,
 }
 
@@ -121,6 +147,7 @@ const _: () = assert!(offset_of!(GpuRefineJob, x) == 16);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct RefinePush {
+    /// The master seed: every displacement derives from it and the point's key.
     pub seed: u32,
     /// detail-amplitude: the displacement of level 0.
     pub amplitude: f32,
@@ -137,10 +164,15 @@ const _: () = assert!(size_of::<RefinePush>() == 16);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FramePush {
+    /// Camera-relative world to clip space (the camera at the origin).
     pub view_projection: [[f32; 4]; 4],
+    /// xyz: towards the sun; w: sea level.
     pub sun: [f32; 4],
+    /// x: radius; y: vertices per patch edge; z: the packed water and view modes; w: the lowest terrain height.
     pub planet: [f32; 4],
+    /// x: the transmittance table's slot; y: time; z: the colour bands' height unit; w: vertex capture.
     pub extra: [f32; 4],
+    /// xyz: the camera from the planet's centre; w: atmosphere-height.
     pub camera: [f32; 4],
 }
 
@@ -152,13 +184,22 @@ const _: () = assert!(offset_of!(FramePush, camera) == 112);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PatchInstance {
+    /// xyz: radius x centre direction - camera (from f64); w: level.
     pub centre_rel: [f32; 4],
+    /// xyz: the unit centre direction; w: world distance between neighbouring vertices.
     pub centre_dir: [f32; 4],
+    /// xyz: the patch centre on the cube; w: its length.
     pub cube_centre: [f32; 4],
+    /// xyz: the cube-space step across the patch along i; w: 2 cube_centre . axis_u.
     pub axis_u: [f32; 4],
+    /// The same along j.
     pub axis_v: [f32; 4],
+    /// xy: the source texel of vertex (0, 0); z: source texels per vertex; w: skirt length.
     pub tex_rect: [f32; 4],
+    /// x: base-height slot; y: river slot or -1; z: drawn quadrants; w: the parent's river slot or -1.
     pub slots: [i32; 4],
+    /// x: where morphing starts (share of the switch distance); y: 1 / the morph band; zw: vertex (0, 0) in the
+    /// parent's river texture.
     pub morph: [f32; 4],
     /// The switch distances at the patch's corners (0,0), (1,0), (0,1), (1,1) (`LodParams::switch_distances`).
     pub switch_distances: [f32; 4],
