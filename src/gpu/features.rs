@@ -6,21 +6,26 @@ use ash::vk;
 /// One required capability and whether the device has it.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct FeatureCheck {
+    /// The feature's Vulkan name.
     pub name: &'static str,
+    /// Whether the device has it.
     pub supported: bool,
 }
 
 /// The required features of one physical device, each yes/no.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct FeatureReport {
+    /// Every required feature, in the order they are enabled.
     pub checks: Vec<FeatureCheck>,
 }
 
 impl FeatureReport {
+    /// Whether the device has every required feature.
     pub fn all_supported(&self) -> bool {
         self.checks.iter().all(|c| c.supported)
     }
 
+    /// The required features the device lacks.
     pub fn missing(&self) -> Vec<&'static str> {
         self.checks
             .iter()
@@ -142,12 +147,16 @@ pub fn query(
 
 /// The feature structs to chain into `VkDeviceCreateInfo`, with exactly the required features enabled.
 pub struct EnabledFeatures {
+    /// Vulkan 1.0 features.
     pub core: vk::PhysicalDeviceFeatures,
+    /// Vulkan 1.2 features.
     pub v12: vk::PhysicalDeviceVulkan12Features<'static>,
+    /// Vulkan 1.3 features.
     pub v13: vk::PhysicalDeviceVulkan13Features<'static>,
 }
 
 impl EnabledFeatures {
+    /// Exactly the features riverplanet requires, enabled.
     pub fn required() -> Self {
         Self {
             core: vk::PhysicalDeviceFeatures::default()
@@ -184,9 +193,13 @@ impl EnabledFeatures {
 /// subgroup and requires full subgroups of that size).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SubgroupProperties {
+    /// Stages with subgroup operations.
     pub supported_stages: vk::ShaderStageFlags,
+    /// The subgroup operations there are.
     pub supported_operations: vk::SubgroupFeatureFlags,
+    /// Stages that can require a subgroup size.
     pub required_size_stages: vk::ShaderStageFlags,
+    /// The largest subgroup size.
     pub max_size: u32,
     /// Subgroups a compute workgroup may hold: with a required subgroup size, workgroups are limited to this many
     /// subgroups of that size.

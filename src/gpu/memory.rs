@@ -17,17 +17,22 @@ use super::{
 /// A buffer request. `name` goes to the debug-utils object name and to the allocation.
 #[derive(Clone, Debug)]
 pub struct BufferDesc<'a> {
+    /// Its debug name.
     pub name: &'a str,
+    /// Bytes.
     pub size: u64,
     /// Every way the buffer will be used (its usage flags follow: gpu/access.rs).
     pub uses: &'a [Access],
+    /// Device-local, or mapped for upload or readback.
     pub location: MemoryLocation,
 }
 
 /// A buffer: `size` bytes as requested, in a Vulkan buffer of its shape's capacity (which may be larger).
 pub struct Buffer {
     pub(super) raw: vk::Buffer,
+    /// Bytes, as requested.
     pub size: u64,
+    /// Its debug name.
     pub name: String,
     allocation: Option<Allocation>,
     shape: BufferShape,
@@ -57,6 +62,7 @@ impl Buffer {
             .map(|s| &s[..self.size as usize])
     }
 
+    /// Its bytes for writing, if its memory is mapped.
     pub fn mapped_mut(&mut self) -> Option<&mut [u8]> {
         let size = self.size as usize;
         self.allocation
@@ -92,9 +98,13 @@ impl Buffer {
 /// An image request: 2D, with `layers` array layers and one mip level.
 #[derive(Clone, Debug)]
 pub struct ImageDesc<'a> {
+    /// Its debug name.
     pub name: &'a str,
+    /// Texels across and down.
     pub extent: vk::Extent2D,
+    /// Array layers.
     pub layers: u32,
+    /// Texel format.
     pub format: vk::Format,
     /// Every way the image will be used (its usage flags follow: gpu/access.rs).
     pub uses: &'a [Access],
@@ -102,12 +112,17 @@ pub struct ImageDesc<'a> {
     pub array: bool,
 }
 
+/// An image with its view, its memory, and the use it was last recorded for.
 pub struct Image {
     pub(super) raw: vk::Image,
     pub(super) view: vk::ImageView,
+    /// Texels across and down.
     pub extent: vk::Extent2D,
+    /// Array layers.
     pub layers: u32,
+    /// Texel format.
     pub format: vk::Format,
+    /// Its debug name.
     pub name: String,
     allocation: Option<Allocation>,
     shape: ImageShape,

@@ -47,29 +47,60 @@ use ash::vk;
 /// Everything that can go wrong in the backend. The failing Vulkan call travels with its result.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
+    /// libvulkan.so.1 cannot be loaded (the loader's message).
     #[error("cannot load the Vulkan loader (libvulkan.so.1): {0}; install libvulkan1 and a driver (tools/setup)")]
     Loader(String),
+    /// A Vulkan call returned an error.
     #[error("{call} failed: {result}")]
     Vk {
+        /// The call.
         call: &'static str,
+        /// What it returned.
         result: vk::Result,
     },
+    /// The device was lost (VK_ERROR_DEVICE_LOST).
     #[error("the GPU device was lost during {call}; restart the program (driver reset or crash)")]
-    DeviceLost { call: &'static str },
+    DeviceLost {
+        /// The call that found it lost.
+        call: &'static str,
+    },
+    /// No Vulkan device at all.
     #[error("no Vulkan device found; install a driver (tools/setup installs Mesa lavapipe)")]
     NoDevice,
+    /// `--adapter` matches no device.
     #[error("no Vulkan device name contains '{filter}' (--adapter / RIVERPLANET_ADAPTER); devices: {available}")]
-    NoMatchingAdapter { filter: String, available: String },
+    NoMatchingAdapter {
+        /// The text asked for.
+        filter: String,
+        /// The devices there are.
+        available: String,
+    },
+    /// The device lacks a required feature (gpu/features.rs).
     #[error("device '{device}' lacks required Vulkan feature(s): {missing}")]
-    MissingFeature { device: String, missing: String },
+    MissingFeature {
+        /// The device's name.
+        device: String,
+        /// The features it lacks.
+        missing: String,
+    },
+    /// The device runs compute but is known to fail drawing (adapter.rs `cannot_draw`: lavapipe with narrow vectors).
     #[error("device '{device}' cannot draw this renderer: {reason}")]
-    CannotDraw { device: String, reason: String },
+    CannotDraw {
+        /// The device's name.
+        device: String,
+        /// What it lacks.
+        reason: String,
+    },
+    /// gpu-allocator could not allocate.
     #[error("GPU memory allocation for '{name}' failed: {source}")]
     Allocation {
+        /// The resource's name.
         name: String,
+        /// gpu-allocator's error.
         #[source]
         source: gpu_allocator::AllocationError,
     },
+    /// A request that cannot be met (a job too large, no free bindless slot, a buffer that is not host-visible).
     #[error("invalid request: {0}")]
     Invalid(String),
 }
