@@ -15,28 +15,46 @@ const STREAM_PERTURB: u64 = 0xC0_0002;
 /// Errors of continent generation from an image.
 #[derive(Debug, thiserror::Error)]
 pub enum ContinentError {
+    /// The image is missing or cannot be decoded.
     #[error("cannot read continents image {path}: {message}")]
-    Unreadable { path: String, message: String },
+    Unreadable {
+        /// The image.
+        path: String,
+        /// The decoder's message.
+        message: String,
+    },
+    /// Not twice as wide as high, or too small.
     #[error(
         "continents image {path} is {width}x{height}; an equirectangular image must be twice as wide as high \
          (e.g. 2048x1024) and at least 8x4"
     )]
     WrongSize {
+        /// The image.
         path: String,
+        /// Its pixels across.
         width: u32,
+        /// Its pixels down.
         height: u32,
     },
+    /// All land or all sea.
     #[error(
         "continents image {path} is all {what}: land is brighter than middle grey, sea darker, and a planet needs \
          both"
     )]
-    Uniform { path: String, what: &'static str },
+    Uniform {
+        /// The image.
+        path: String,
+        /// "land" or "sea".
+        what: &'static str,
+    },
 }
 
 /// The Voronoi feature points of Section 4.1.
 #[derive(Clone, Debug)]
 pub struct FeaturePoints {
+    /// The continents' centres: land is nearer one of them than the water points (by the weight).
     pub continental: Vec<DVec3>,
+    /// The water points between them.
     pub water: Vec<DVec3>,
 }
 
@@ -102,6 +120,7 @@ pub fn water_points(continental: &[DVec3]) -> Vec<DVec3> {
 }
 
 impl FeaturePoints {
+    /// The feature points of the planet of `seed` with `continents` continents.
     pub fn generate(seed: u64, continents: usize) -> Self {
         let continental = continental_points(seed, continents);
         let water = water_points(&continental);
@@ -198,6 +217,7 @@ pub struct ContinentImage {
 }
 
 impl ContinentImage {
+    /// Reads `path` and checks it is an equirectangular image with land and sea.
     pub fn load(path: &Path) -> Result<Self, ContinentError> {
         let unreadable = |message: String| ContinentError::Unreadable {
             path: path.display().to_string(),

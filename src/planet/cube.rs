@@ -75,6 +75,7 @@ pub enum Edge {
     North,
 }
 
+/// The four edges, in the order the code enumerates them.
 pub const EDGES: [Edge; 4] = [Edge::West, Edge::East, Edge::South, Edge::North];
 
 impl Edge {
@@ -106,8 +107,11 @@ impl Edge {
 /// Which edge of which face meets `edge` of `face`, and whether the edge parameter runs the other way there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Adjacency {
+    /// The neighbouring face.
     pub face: usize,
+    /// Its edge that meets ours.
     pub edge: Edge,
+    /// Whether the edge parameter runs the other way there.
     pub reversed: bool,
 }
 
@@ -146,13 +150,18 @@ pub fn face_of_on(face: usize, p: DVec3) -> (usize, f64, f64) {
 /// A quadtree patch: face, level (0 = the whole face) and position in the level's 2^level x 2^level grid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct PatchId {
+    /// The cube face, 0 to 5.
     pub face: u8,
+    /// The quadtree level.
     pub level: u8,
+    /// Column in the level's grid (along u).
     pub x: u32,
+    /// Row in the level's grid (along v).
     pub y: u32,
 }
 
 impl PatchId {
+    /// The patch covering the whole of `face`.
     pub fn root(face: usize) -> Self {
         Self {
             face: face as u8,
@@ -247,6 +256,7 @@ impl PatchId {
         }
     }
 
+    /// The patch one level up that contains this one (`None` for a root).
     pub fn parent(self) -> Option<Self> {
         (self.level > 0).then(|| Self {
             face: self.face,

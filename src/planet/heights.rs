@@ -20,7 +20,9 @@ use super::{
 /// i), with u = -1 + 2 i / cells and v = -1 + 2 j / cells.
 #[derive(Clone)]
 pub struct FaceLattice {
+    /// Cells per face edge.
     pub cells: u32,
+    /// The heights, face after face.
     pub data: Vec<f32>,
 }
 
@@ -29,6 +31,7 @@ fn axis(v: DVec3) -> I64Vec3 {
 }
 
 impl FaceLattice {
+    /// A lattice of `cells` cells per face edge, every height `fill`.
     pub fn new(cells: u32, fill: f32) -> Self {
         let side = cells as usize + 1;
         Self {
@@ -37,19 +40,23 @@ impl FaceLattice {
         }
     }
 
+    /// Points per face edge.
     pub fn side(&self) -> usize {
         self.cells as usize + 1
     }
 
+    /// Where point (i, j) of `face` lies in `data`.
     pub fn index(&self, face: usize, i: u32, j: u32) -> usize {
         let side = self.side();
         face * side * side + j as usize * side + i as usize
     }
 
+    /// The height of point (i, j) of `face`.
     pub fn get(&self, face: usize, i: u32, j: u32) -> f32 {
         self.data[self.index(face, i, j)]
     }
 
+    /// The heights' size in memory.
     pub fn bytes(&self) -> u64 {
         (self.data.len() * std::mem::size_of::<f32>()) as u64
     }
