@@ -41,12 +41,15 @@ fn specialization_entries(data: &[u8]) -> Vec<vk::SpecializationMapEntry> {
 /// A descriptor set layout of `count` storage buffers at bindings 0..count, for per-dispatch inputs (samples,
 /// range table). Sets are allocated per recording with [`super::Recorder::buffer_set`].
 pub struct BufferSetLayout {
+    /// The Vulkan layout.
     pub layout: vk::DescriptorSetLayout,
+    /// Storage buffers it binds.
     pub count: u32,
     _retire: RetireOnDrop,
 }
 
 impl BufferSetLayout {
+    /// A layout of `count` storage buffers, named `name` for debuggers.
     pub fn new(ctx: &Context, count: u32, name: &str) -> Result<Self, GpuError> {
         let bindings: Vec<_> = (0..count)
             .map(|b| {
@@ -79,9 +82,13 @@ pub struct ComputePipeline {
 
 /// What a compute pipeline needs, as [`GraphicsDesc`] says it for graphics.
 pub struct ComputeDesc<'a> {
+    /// Its debug name.
     pub name: &'a str,
+    /// The compute shader's SPIR-V.
     pub spirv: &'a [u8],
+    /// Its descriptor set layouts, set 0 first.
     pub set_layouts: &'a [vk::DescriptorSetLayout],
+    /// Bytes of push constants (0: none).
     pub push_constant_bytes: u32,
     /// The shader's specialization constants: the bytes (`bytemuck::bytes_of`) of a `#[repr(C)]` Pod struct or
     /// array of `u32`s, field k being `constant_id` k; empty for none.
@@ -92,6 +99,7 @@ pub struct ComputeDesc<'a> {
 }
 
 impl ComputePipeline {
+    /// Builds the pipeline `desc` says.
     pub fn new(ctx: &Context, desc: &ComputeDesc) -> Result<Self, GpuError> {
         let ComputeDesc {
             name,
@@ -167,20 +175,31 @@ impl ComputePipeline {
 /// What a graphics pipeline of the terrain renderer needs: vertex, geometry and fragment shaders, dynamic
 /// rendering into one colour and one depth attachment, and a few fixed-function choices.
 pub struct GraphicsDesc<'a> {
+    /// Its debug name.
     pub name: &'a str,
+    /// The vertex shader's SPIR-V.
     pub vertex: &'a [u8],
+    /// The geometry shader's SPIR-V, if there is one.
     pub geometry: Option<&'a [u8]>,
+    /// The fragment shader's SPIR-V.
     pub fragment: &'a [u8],
+    /// Its descriptor set layouts, set 0 first.
     pub set_layouts: &'a [vk::DescriptorSetLayout],
+    /// Bytes of push constants, visible to every stage (0: none).
     pub push_constant_bytes: u32,
     /// Specialization constants given to every stage, as [`ComputeDesc::specialization`].
     pub specialization: &'a [u8],
+    /// The colour attachment's format.
     pub color_format: vk::Format,
+    /// The depth attachment's format.
     pub depth_format: vk::Format,
+    /// Whether it writes depth.
     pub depth_write: bool,
     /// Depth test: GREATER (reversed Z).
     pub depth_test: bool,
+    /// How its colour combines with the attachment's.
     pub blend: Blend,
+    /// Draw triangles as lines.
     pub wireframe: bool,
     /// Cull triangles seen from behind (counter-clockwise in framebuffer coordinates is the front): for closed
     /// surfaces, whose back faces are always hidden.
@@ -207,6 +226,7 @@ pub struct GraphicsPipeline {
 }
 
 impl GraphicsPipeline {
+    /// Builds the pipeline `desc` says.
     pub fn new(ctx: &Context, desc: &GraphicsDesc) -> Result<Self, GpuError> {
         let stages_all = vk::ShaderStageFlags::VERTEX
             | vk::ShaderStageFlags::GEOMETRY
@@ -366,7 +386,9 @@ pub struct RenderTarget {
 /// Which attachment of a [`RenderTarget`] a barrier is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Attachment {
+    /// The colour image.
     Color,
+    /// The depth image.
     Depth,
 }
 
@@ -385,6 +407,7 @@ impl RenderTarget {
         }
     }
 
+    /// Its size in pixels.
     pub fn extent(&self) -> vk::Extent2D {
         self.extent
     }
