@@ -17,12 +17,16 @@ use crate::{
 /// A patch's 2D frame.
 #[derive(Clone, Copy, Debug)]
 pub struct PatchFrame {
+    /// The patch.
     pub patch: PatchId,
+    /// The planet's radius.
     pub radius: f64,
+    /// Vertices per patch edge.
     pub vertices: u32,
 }
 
 impl PatchFrame {
+    /// The frame of `patch` on a planet of `radius` with `vertices` per patch edge.
     pub fn new(patch: PatchId, radius: f64, vertices: u32) -> Self {
         Self {
             patch,
@@ -103,6 +107,7 @@ fn finer_streams_reach(network: &RiverNetwork, frame: &PatchFrame) -> bool {
 /// A patch's river samples, and whether they are the rivers' final detail.
 #[derive(Clone, Debug, Default)]
 pub struct PatchSamples {
+    /// The samples whose influence reaches the patch.
     pub samples: Vec<RiverSample>,
     /// Whether every piece these samples come from is as fine as any level subdivides it (at [`MAX_DEPTH`] or
     /// no longer than [`sample_step`]) and sampled [`sample_step`] apart. Then every descendant patch gets the
@@ -238,10 +243,13 @@ pub fn piece_samples<'a>(
 /// One branch (main river or tributary) of a system as a polyline on the unit sphere.
 #[derive(Clone, Debug)]
 pub struct Branch {
+    /// The branch's key (its segments' `branch`).
     pub key: u64,
     /// The branch this one flows into (`None` for the main river).
     pub parent: Option<u64>,
+    /// The full width at its first and its last point.
     pub widths: (f32, f32),
+    /// Unit directions, upstream first.
     pub points: Vec<DVec3>,
 }
 

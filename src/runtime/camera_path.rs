@@ -13,9 +13,12 @@ use super::camera::Camera;
 /// The viewer's vertical field of view, which every recorded frame was seen through.
 pub const FOV_DEGREES: f64 = 60.0;
 
+/// A recorded flight (`view --record`, bookmarks.json): the planet's seed and the camera of every frame.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct CameraPath {
+    /// The seed of the planet it was recorded over.
     pub seed: u32,
+    /// The camera of each frame, in order.
     pub frames: Vec<PathFrame>,
 }
 
@@ -24,18 +27,23 @@ pub const MAX_FRAMES: usize = 108_000;
 /// The largest camera-path file read: a generous 1 KB a frame.
 const MAX_FILE_BYTES: u64 = MAX_FRAMES as u64 * 1024;
 
+/// The camera of one recorded frame, in world units from the planet's centre.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 pub struct PathFrame {
     /// Seconds since the path started.
     pub time: f64,
+    /// The eye.
     pub position: [f64; 3],
+    /// The unit view direction.
     pub forward: [f64; 3],
+    /// The screen's up.
     pub up: [f64; 3],
     /// Above the drawn surface (terrain or water) below the camera.
     pub altitude: f64,
 }
 
 impl PathFrame {
+    /// A frame from vectors.
     pub fn new(time: f64, position: DVec3, forward: DVec3, up: DVec3, altitude: f64) -> Self {
         Self {
             time,
