@@ -13,6 +13,7 @@ use riverplanet::{
     config::{Config, LodRule},
     gpu::Context,
     render::{
+        ground::Ground,
         presets::{self, Preset},
         target::Offscreen,
         Renderer, ViewMode, WaterMode,
@@ -53,9 +54,23 @@ fn render_air(ctx: &Context, camera: &Camera, size: [u32; 2], on: bool) -> image
 }
 
 fn preset_camera(preset: Preset, aspect: f64) -> Camera {
-    let (eye, target) = presets::camera(preset, world()).unwrap();
-    let ground = riverplanet::render::ground::Ground::new(world()).height_below(eye, world());
-    let altitude = eye.length() - world().planet.radius - ground;
+    let mut ground = Ground::new(world());
+    camera_over(
+        world(),
+        &mut ground,
+        presets::camera(preset, world()).unwrap(),
+        aspect,
+    )
+}
+
+/// A 45-degree camera at `eye` looking at `target`, its near plane set by its altitude over `ground`.
+fn camera_over(
+    world: &World,
+    ground: &mut Ground,
+    (eye, target): (DVec3, DVec3),
+    aspect: f64,
+) -> Camera {
+    let altitude = eye.length() - world.planet.radius - ground.height_below(eye, world);
     Camera::look_at(
         eye,
         target,
@@ -245,17 +260,9 @@ fn river_views(
     systems: usize,
     heights: &[f64],
 ) -> Vec<(String, Camera)> {
-    let mut ground = riverplanet::render::ground::Ground::new(world);
-    let mut camera = |eye: DVec3, target: DVec3| {
-        let altitude = eye.length() - world.planet.radius - ground.height_below(eye, world);
-        Camera::look_at(
-            eye,
-            target,
-            45.0,
-            aspect,
-            riverplanet::runtime::camera::near_plane(altitude),
-        )
-    };
+    let mut ground = Ground::new(world);
+    let mut camera =
+        |eye: DVec3, target: DVec3| camera_over(world, &mut ground, (eye, target), aspect);
     let mut views = Vec::new();
     for (k, system) in world.network.systems.iter().take(systems).enumerate() {
         let suffix = if k == 0 {

@@ -434,40 +434,30 @@ fn write_geotiff(
 #[test]
 fn a_region_is_placed_on_the_procedural_planet() {
     let dir = temp_dir("region");
-    let region = dir.join("region.tif");
     let bounds = [-30.0, -20.0, 30.0, 25.0];
     let bounds_text = format!("{},{},{},{}", bounds[0], bounds[1], bounds[2], bounds[3]);
-    succeeds(&[
-        "export",
-        "region",
-        "--seed",
-        "2",
-        "--bounds",
-        &bounds_text,
-        "--level",
-        "3",
-        "--out",
-        region.to_str().unwrap(),
-    ]);
+    // Seed 2's region at level 3 as `format`, to `dir/region.EXT`.
+    let export = |format: &str, extension: &str| {
+        let path = dir.join(format!("region.{extension}"));
+        let out = path.to_str().unwrap();
+        let args = [
+            "export",
+            "region",
+            "--seed",
+            "2",
+            "--bounds",
+            &bounds_text,
+            "--level",
+            "3",
+        ];
+        succeeds(&[&args[..], &["--format", format, "--out", out]].concat());
+        path
+    };
+    let region = export("tiff", "tif");
     let file = TerrainFile::load(&region, (1.0, 0.0), 0.4, None).unwrap();
     assert!(file.is_region());
     // The same region as a 16-bit PNG is placed by the JSON beside it, with the same heights within their step.
-    let png = dir.join("region.png");
-    succeeds(&[
-        "export",
-        "region",
-        "--seed",
-        "2",
-        "--bounds",
-        &bounds_text,
-        "--level",
-        "3",
-        "--format",
-        "png",
-        "--out",
-        png.to_str().unwrap(),
-    ]);
-    let png = TerrainFile::load(&png, (1.0, 0.0), 0.4, None).unwrap();
+    let png = TerrainFile::load(&export("png", "png"), (1.0, 0.0), 0.4, None).unwrap();
     assert!(png.is_region());
     assert_eq!(png.bounds(), file.bounds());
     let centre = direction_at(0.0, 2.5);

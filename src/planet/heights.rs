@@ -51,6 +51,13 @@ impl FaceLattice {
         face * side * side + j as usize * side + i as usize
     }
 
+    /// The face and (i, j) of the point at `index` in `data` (the inverse of [`FaceLattice::index`]).
+    pub fn point_of(&self, index: usize) -> (usize, u32, u32) {
+        let side = self.side();
+        let (face, rest) = (index / (side * side), index % (side * side));
+        (face, (rest % side) as u32, (rest / side) as u32)
+    }
+
     /// The height of point (i, j) of `face`.
     pub fn get(&self, face: usize, i: u32, j: u32) -> f32 {
         self.data[self.index(face, i, j)]

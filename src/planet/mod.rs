@@ -187,26 +187,14 @@ impl Planet {
             )?),
             _ => None,
         };
-        // A region lies on the procedural planet (eroded relief) and needs a few of its lattice's cells.
+        // A region lies on the procedural planet (eroded relief).
         let region = terrain.as_ref().filter(|t| t.is_region());
         if let Some(region) = region {
-            let [west, south, east, north] = region.bounds();
-            let cell = 90.0 / base_cells as f64;
-            if (east - west).min(north - south) < 2.0 * cell {
-                return Err(TerrainFileError::BadPlacement {
-                    path: p.terrain_file.clone(),
-                    message: format!(
-                        "its region spans {:.3} x {:.3} degrees; it must span at least two of the base \
-                         lattice's cells ({cell:.3} degrees with base-resolution {})",
-                        east - west,
-                        north - south,
-                        p.base_resolution
-                    ),
-                }
-                .into());
-            }
+            region.check_spans_cells(&p.terrain_file, base_cells)?;
         }
         let whole_file = terrain.as_ref().filter(|t| !t.is_region());
+        // The eroded relief, also around a region; a whole planet's file heights are the relief.
+        let eroded = p.relief_model == ReliefModel::Eroded || region.is_some();
         if terrain.is_some() {
             time("terrain file", t);
         }
@@ -299,7 +287,6 @@ impl Planet {
                     )
                 }
             };
-            let eroded = p.relief_model == ReliefModel::Eroded || region.is_some();
             let land = match &grid {
                 Some(grid) if eroded => coasts::roughen(grid, &base, &points, &land, seed64),
                 _ => land,
@@ -328,19 +315,16 @@ impl Planet {
                     (mountains, None)
                 }
                 Some(grid) => {
-                    match p.relief_model {
-                        // A whole planet's file heights are the relief.
-                        ReliefModel::File if region.is_none() => {}
-                        ReliefModel::Eroded | ReliefModel::File => {
-                            erosion = Some(erosion::raise(
-                                &mut base,
-                                grid,
-                                p,
-                                config.river.lake_depth as f64,
-                                seed64,
-                            ))
-                        }
-                        _ => relief::raise(&mut base, grid, p, seed64),
+                    if eroded {
+                        erosion = Some(erosion::raise(
+                            &mut base,
+                            grid,
+                            p,
+                            config.river.lake_depth as f64,
+                            seed64,
+                        ));
+                    } else if p.relief_model != ReliefModel::File {
+                        relief::raise(&mut base, grid, p, seed64);
                     }
                     if let Some(region) = region {
                         region.paste(&mut base);

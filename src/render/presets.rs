@@ -118,14 +118,12 @@ pub fn river_view(world: &World, system: &RiverSystem) -> (DVec3, DVec3) {
 /// The direction of the highest point of the precomputed heights.
 fn highest_point(world: &World) -> DVec3 {
     let lattice = &world.planet.lattice;
-    let side = lattice.side();
     let (index, _) =
         lattice.data.iter().enumerate().fold(
             (0, f32::MIN),
             |best, (k, &h)| if h > best.1 { (k, h) } else { best },
         );
-    let (face, rest) = (index / (side * side), index % (side * side));
-    let (i, j) = ((rest % side) as u32, (rest / side) as u32);
+    let (face, i, j) = lattice.point_of(index);
     lattice.direction(lattice.key(face, i, j))
 }
 

@@ -11,6 +11,9 @@ use rayon::prelude::*;
 
 use super::{cube::FACES, heights::FaceLattice};
 
+mod read;
+use read::{bounds_beside, read_exr, read_png, read_tiff};
+
 /// Why a terrain file cannot be used; each names the file and what a usable one needs.
 #[derive(Debug, thiserror::Error)]
 pub enum TerrainFileError {
@@ -274,6 +277,26 @@ impl TerrainFile {
         self.placement.bounds(self.width, self.height)
     }
 
+    /// Refuses a region (read from `path`) spanning fewer than two cells of a base lattice of `base_cells` cells
+    /// per face edge: no lattice point, or one, would take its heights.
+    pub fn check_spans_cells(&self, path: &str, base_cells: u32) -> Result<(), TerrainFileError> {
+        let [west, south, east, north] = self.bounds();
+        let cell = 90.0 / base_cells as f64;
+        if (east - west).min(north - south) >= 2.0 * cell {
+            return Ok(());
+        }
+        Err(TerrainFileError::BadPlacement {
+            path: path.to_string(),
+            message: format!(
+                "its region spans {:.3} x {:.3} degrees; it must span at least two of the base lattice's cells \
+                 ({cell:.3} degrees with base-resolution {})",
+                east - west,
+                north - south,
+                base_cells + 1
+            ),
+        })
+    }
+
     /// Where direction `p` falls on the raster, in pixels from its north-west corner (longitudes east of the west
     /// edge, wrapping once round the sphere).
     fn pixel_of(&self, p: DVec3) -> (f64, f64) {
@@ -333,7 +356,6 @@ impl TerrainFile {
     /// stride). The carved beds, everything the base lattice holds, and diamond-square's detail below the file's
     /// pixels stay; a file no finer than the base lattice is left out.
     pub fn add_detail(&self, base: &FaceLattice, fine: &mut FaceLattice) {
-        let (side, base_side) = (fine.side(), base.side());
         let scale = fine.cells / base.cells;
         // Levels below the base lattice whose cells the file's pixels resolve (cells of 90 / cells degrees).
         let (dx, dy) = self.placement.degrees_per_pixel;
@@ -344,55 +366,34 @@ impl TerrainFile {
             return;
         }
         let stride = scale >> resolved;
-        let file_at_base: Vec<f64> = (0..FACES * base_side * base_side)
+        let file_at_base: Vec<f64> = (0..base.data.len())
             .into_par_iter()
             .map(|k| {
-                let (face, rest) = (k / (base_side * base_side), k % (base_side * base_side));
-                let (i, j) = ((rest % base_side) as u32, (rest / base_side) as u32);
+                let (face, i, j) = base.point_of(k);
                 self.height_towards(base.direction(base.key(face, i, j)))
             })
             .collect();
         let lattice = &*fine;
-        let detailed: Vec<f32> = (0..FACES * side * side)
+        let detailed: Vec<f32> = (0..lattice.data.len())
             .into_par_iter()
             .map(|k| {
-                let (face, rest) = (k / (side * side), k % (side * side));
-                let (i, j) = ((rest % side) as u32, (rest / side) as u32);
+                let (face, i, j) = lattice.point_of(k);
                 let own = lattice.data[k] as f64;
                 let p = lattice.direction(lattice.key(face, i, j));
                 let weight = self.weight_towards(p);
                 if weight == 0.0 {
                     return own as f32;
                 }
-                // The base cell holding the point, and where in it.
-                let (bi, bj) = (
-                    (i / scale).min(base.cells - 1),
-                    (j / scale).min(base.cells - 1),
-                );
-                let (fx, fy) = (
-                    (i - bi * scale) as f64 / scale as f64,
-                    (j - bj * scale) as f64 / scale as f64,
-                );
-                let bilinear = |at: &dyn Fn(u32, u32) -> f64| {
-                    let top = at(bi, bj) * (1.0 - fx) + at(bi + 1, bj) * fx;
-                    let bottom = at(bi, bj + 1) * (1.0 - fx) + at(bi + 1, bj + 1) * fx;
-                    top * (1.0 - fy) + bottom * fy
+                let coarse = |stride: u32, at: &dyn Fn(u32, u32) -> f64| {
+                    bilinear_between(lattice.cells, stride, (i, j), at)
                 };
-                let carved = bilinear(&|i, j| base.get(face, i, j) as f64);
-                let file_coarse = bilinear(&|i, j| file_at_base[base.index(face, i, j)]);
+                // The base lattice (carved, and the file at its points) and the finest resolved level, bilinear.
+                let carved = coarse(scale, &|i, j| base.get(face, i, j) as f64);
+                let file_coarse = coarse(scale, &|i, j| file_at_base[base.index(face, i, j)]);
                 let file_detail = self.height_towards(p) - file_coarse;
-                // The finest resolved level's lattice, bilinear at the point.
-                let (li, lj) = (
-                    (i / stride).min(fine.cells / stride - 1),
-                    (j / stride).min(fine.cells / stride - 1),
-                );
-                let (gx, gy) = (
-                    (i - li * stride) as f64 / stride as f64,
-                    (j - lj * stride) as f64 / stride as f64,
-                );
-                let at = |i: u32, j: u32| lattice.get(face, i * stride, j * stride) as f64;
-                let level = (at(li, lj) * (1.0 - gx) + at(li + 1, lj) * gx) * (1.0 - gy)
-                    + (at(li, lj + 1) * (1.0 - gx) + at(li + 1, lj + 1) * gx) * gy;
+                let level = coarse(stride, &|i, j| {
+                    lattice.get(face, i * stride, j * stride) as f64
+                });
                 (own + weight * (carved - level + file_detail)) as f32
             })
             .collect();
@@ -418,184 +419,25 @@ impl TerrainFile {
     }
 }
 
-type Heights = (u32, u32, Vec<f32>);
-
-/// A TIFF's heights, and where its GeoTIFF tags place it, if they do.
-fn read_tiff(path: &Path) -> Result<(Heights, Option<Placement>), String> {
-    use tiff::decoder::{Decoder, DecodingResult};
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let mut decoder = Decoder::new(std::io::BufReader::new(file)).map_err(|e| e.to_string())?;
-    let (width, height) = decoder.dimensions().map_err(|e| e.to_string())?;
-    let placement = georeference(&mut decoder)?;
-    let heights = match decoder.read_image().map_err(|e| e.to_string())? {
-        DecodingResult::F32(v) => v,
-        DecodingResult::F64(v) => v.into_iter().map(|h| h as f32).collect(),
-        DecodingResult::I16(v) => v.into_iter().map(f32::from).collect(),
-        DecodingResult::I32(v) => v.into_iter().map(|h| h as f32).collect(),
-        _ => {
-            return Err(
-                "a TIFF's samples must be one channel of 32- or 64-bit floats or 16- or 32-bit signed integers \
-                 (heights as they are)"
-                    .into(),
-            )
-        }
-    };
-    Ok((one_channel(width, height, heights)?, placement))
-}
-
-/// GeoTIFF 1.1 (OGC 19-008): ModelPixelScale and one ModelTiepoint in a geographic model in degrees (GTModelType 2,
-/// angular units 9102 where given); a raster of points (GTRasterType 2) covers half a pixel more on each side.
-fn georeference<R: std::io::Read + std::io::Seek>(
-    decoder: &mut tiff::decoder::Decoder<R>,
-) -> Result<Option<Placement>, String> {
-    use tiff::tags::Tag;
-    let mut doubles = |tag: Tag| -> Result<Option<Vec<f64>>, String> {
-        match decoder.find_tag(tag).map_err(|e| e.to_string())? {
-            Some(value) => value.into_f64_vec().map(Some).map_err(|e| e.to_string()),
-            None => Ok(None),
-        }
-    };
-    let (Some(scale), Some(tie)) = (
-        doubles(Tag::ModelPixelScaleTag)?,
-        doubles(Tag::ModelTiepointTag)?,
-    ) else {
-        return Ok(None);
-    };
-    if scale.len() < 2 || tie.len() < 6 || scale[0] <= 0.0 || scale[1] <= 0.0 {
-        return Err(format!(
-            "its GeoTIFF tags need ModelPixelScale (two positive numbers) and a ModelTiepoint (six numbers); it has \
-             {scale:?} and {tie:?}"
-        ));
-    }
-    let keys: Vec<u16> = match decoder
-        .find_tag(Tag::GeoKeyDirectoryTag)
-        .map_err(|e| e.to_string())?
-    {
-        Some(value) => value.into_u16_vec().map_err(|e| e.to_string())?,
-        None => Vec::new(),
-    };
-    let key = |id: u16| {
-        keys.get(4..)
-            .unwrap_or_default()
-            .chunks_exact(4)
-            .find(|k| k[0] == id && k[1] == 0)
-            .map(|k| k[3])
-    };
-    if let Some(model) = key(1024).filter(|&m| m != 2) {
-        return Err(format!(
-            "its GeoTIFF model type is {model} (1: projected, 3: geocentric); a terrain file must be in longitude \
-             and latitude (model type 2, e.g. EPSG:4326; reproject with gdalwarp -t_srs EPSG:4326)"
-        ));
-    }
-    if let Some(units) = key(2054).filter(|&u| u != 9102) {
-        return Err(format!(
-            "its GeoTIFF angular units are {units}; a terrain file's must be degrees (9102)"
-        ));
-    }
-    let (dx, dy) = (scale[0], scale[1]);
-    let half = if key(1025) == Some(2) { 0.5 } else { 0.0 };
-    Ok(Some(Placement {
-        west: tie[3] - (tie[0] + half) * dx,
-        north: tie[4] + (tie[1] + half) * dy,
-        degrees_per_pixel: (dx, dy),
-    }))
-}
-
-fn read_exr(path: &Path) -> Result<Heights, String> {
-    use exr::prelude::*;
-    let image = read_first_flat_layer_from_file(path).map_err(|e| e.to_string())?;
-    let size = image.layer_data.size;
-    let channel = image
-        .layer_data
-        .channel_data
-        .list
-        .iter()
-        .find(|c| c.name.eq("Y"))
-        .ok_or("an OpenEXR terrain needs its heights in channel Y")?;
-    let heights = channel.sample_data.values_as_f32().collect();
-    one_channel(size.0 as u32, size.1 as u32, heights)
-}
-
-fn read_png(path: &Path, (scale, offset): (f32, f32)) -> Result<Heights, String> {
-    let image = image::ImageReader::open(path)
-        .map_err(|e| e.to_string())?
-        .decode()
-        .map_err(|e| e.to_string())?;
-    if image.color() != image::ColorType::L16 {
-        return Err(format!(
-            "a PNG terrain must be 16-bit grey (this one is {:?})",
-            image.color()
-        ));
-    }
-    let (scale, offset) = match scale_offset_beside(path)? {
-        Some(beside) => beside,
-        None => (scale, offset),
-    };
-    let image = image.into_luma16();
-    let (width, height) = image.dimensions();
-    let heights = image
-        .pixels()
-        .map(|p| offset + scale * p.0[0] as f32)
-        .collect();
-    Ok((width, height, heights))
-}
-
-/// `bounds` (`[west, south, east, north]` in degrees) from the JSON `export` writes beside a raster, if it has
-/// them.
-fn bounds_beside(path: &Path) -> Result<Option<[f64; 4]>, String> {
-    let Some((value, beside)) = json_beside(path)? else {
-        return Ok(None);
-    };
-    let Some(bounds) = value.get("bounds") else {
-        return Ok(None);
-    };
-    let numbers: Option<Vec<f64>> = bounds
-        .as_array()
-        .map(|a| a.iter().filter_map(|v| v.as_f64()).collect());
-    match numbers.as_deref() {
-        Some(&[west, south, east, north]) => Ok(Some([west, south, east, north])),
-        _ => Err(format!(
-            "{} beside it has bounds {bounds} where four numbers [west, south, east, north] belong",
-            beside.display()
-        )),
-    }
-}
-
-/// The JSON `export` writes beside a raster (`PATH.json`), and its path, if there is one.
-fn json_beside(path: &Path) -> Result<Option<(serde_json::Value, std::path::PathBuf)>, String> {
-    let beside = path.with_extension("json");
-    let Ok(text) = std::fs::read_to_string(&beside) else {
-        return Ok(None);
-    };
-    let value = serde_json::from_str(&text)
-        .map_err(|e| format!("{} beside it is not JSON: {e}", beside.display()))?;
-    Ok(Some((value, beside)))
-}
-
-/// `height_scale` and `height_offset` from the JSON `export` writes beside a raster, if there is one.
-fn scale_offset_beside(path: &Path) -> Result<Option<(f32, f32)>, String> {
-    let Some((value, beside)) = json_beside(path)? else {
-        return Ok(None);
-    };
-    let number = |key: &str| {
-        value[key].as_f64().map(|v| v as f32).ok_or_else(|| {
-            format!(
-                "{} beside it has no number {key} (height = height_offset + height_scale x value)",
-                beside.display()
-            )
-        })
-    };
-    Ok(Some((number("height_scale")?, number("height_offset")?)))
-}
-
-fn one_channel(width: u32, height: u32, heights: Vec<f32>) -> Result<Heights, String> {
-    if heights.len() != width as usize * height as usize {
-        return Err(format!(
-            "{} samples for {width}x{height} pixels: a terrain has one channel",
-            heights.len()
-        ));
-    }
-    Ok((width, height, heights))
+/// Bilinear interpolation at point (i, j) of a lattice of `cells` cells per face edge between the points of its
+/// coarser lattice of every `stride`-th point, whose values `at` gives by their coarse (i, j).
+fn bilinear_between(
+    cells: u32,
+    stride: u32,
+    (i, j): (u32, u32),
+    at: &dyn Fn(u32, u32) -> f64,
+) -> f64 {
+    let (ci, cj) = (
+        (i / stride).min(cells / stride - 1),
+        (j / stride).min(cells / stride - 1),
+    );
+    let (fx, fy) = (
+        (i - ci * stride) as f64 / stride as f64,
+        (j - cj * stride) as f64 / stride as f64,
+    );
+    let top = at(ci, cj) * (1.0 - fx) + at(ci + 1, cj) * fx;
+    let bottom = at(ci, cj + 1) * (1.0 - fx) + at(ci + 1, cj + 1) * fx;
+    top * (1.0 - fy) + bottom * fy
 }
 
 #[cfg(test)]
