@@ -29,19 +29,29 @@ type KernelInput = Vec<(f32, Vec<RiverSample>)>;
 /// The four kernel variants on one frame's new river patches (ms).
 #[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct FrameKernels {
+    /// The CPU reference on one thread.
     pub cpu_single_ms: f64,
+    /// The CPU reference on rayon's threads.
     pub cpu_rayon_ms: f64,
+    /// The simple GPU kernel's dispatches (timestamp queries).
     pub gpu_simple_ms: f64,
+    /// The tiled GPU kernel's dispatches (timestamp queries).
     pub gpu_tiled_ms: f64,
+    /// The simple kernel with the upload, the read-back and its decoding (docs/kernel.md).
     pub gpu_simple_end_to_end_ms: f64,
+    /// The tiled kernel with the upload, the read-back and its decoding.
     pub gpu_tiled_end_to_end_ms: f64,
 }
 
+/// One frame of a flight.
 #[derive(Clone, Debug, Serialize)]
 pub struct FlightFrame {
+    /// The camera's height above the sphere (not the ground).
     pub altitude: f64,
+    /// What the renderer reports of the frame.
     #[serde(flatten)]
     pub stats: FrameStats,
+    /// The kernel variants on the frame's new river patches, where compared.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub kernels: Option<FrameKernels>,
     /// Pixels inside the planet's disc showing the clear colour (the descent checks every tenth frame).
@@ -56,7 +66,9 @@ pub struct FlightFrame {
 /// Averages and maxima over a flight.
 #[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct FlightSummary {
+    /// Frames flown.
     pub frames: usize,
+    /// Mean frame time, every frame.
     pub frame_ms_mean: f64,
     /// Triangles the terrain pass drew per frame, on average.
     pub triangles_mean: f64,
@@ -64,23 +76,40 @@ pub struct FlightSummary {
     pub frame_ms_median: f64,
     /// Slowest frame of all, paced or not.
     pub frame_ms_max: f64,
+    /// 1000 over `frame_ms_mean`.
     pub average_fps: f64,
+    /// Patches drawn per frame, on average and at most.
     pub average_visible_patches: f64,
+    /// See `average_visible_patches`.
     pub max_visible_patches: usize,
+    /// Patches given river data per frame, on average and at most.
     pub average_new_patches: f64,
+    /// See `average_new_patches`.
     pub max_new_patches: usize,
+    /// River samples given to the kernel per frame (6.4), on average and at most.
     pub average_samples: f64,
+    /// See `average_samples`.
     pub max_samples: usize,
+    /// Largest memory of any frame: patch textures, temporary sample data and the precomputed heights.
     pub max_memory_bytes: u64,
+    /// Largest bytes of resident patch textures.
     pub max_patch_texture_bytes: u64,
+    /// Largest bytes of one frame's sample buffers.
     pub max_temporary_sample_bytes: u64,
+    /// Most patches resident at once, and the budget they are held to (`max-resident-patches`,
+    /// `resident-memory-mb`).
     pub max_resident_patches: usize,
+    /// See `max_resident_patches`.
     pub resident_patch_budget: usize,
+    /// GPU time per pass (timestamp queries) and CPU time per stage, averaged over the frames, ms.
     pub average_gpu_ms: BTreeMap<String, f64>,
+    /// See `average_gpu_ms`.
     pub average_cpu_ms: BTreeMap<String, f64>,
-    /// Over frames with new river patches: average time of each kernel variant (ms), as Tables 9.1 and 9.2.
+    /// Frames with new river patches whose kernels were compared.
     pub kernel_frames: usize,
+    /// Over those frames: average time of each kernel variant (ms), as Tables 9.1 and 9.2.
     pub kernel_average_ms: BTreeMap<String, f64>,
+    /// Ratios of those averages, named `A_over_B`.
     pub kernel_ratios: BTreeMap<String, f64>,
     /// Average frame time of the same flight in each water mode.
     pub water_mode_frame_ms: BTreeMap<String, f64>,
@@ -102,6 +131,7 @@ pub struct FlightSummary {
     /// Frames checked for holes, and hole pixels found in all of them.
     #[serde(default)]
     pub hole_checked_frames: usize,
+    /// See `hole_checked_frames`.
     #[serde(default)]
     pub hole_pixels: usize,
 }
@@ -112,41 +142,63 @@ pub const HOLE_CHECK_EVERY: u32 = 10;
 /// Frames not counted in `frame_ms_max_after_warmup`.
 pub const WARMUP_FRAMES: usize = 10;
 
+/// What `bench flight` writes: the setup, every frame, and the summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct FlightReport {
+    /// The Vulkan device's name and its driver's name and version.
     pub device: String,
+    /// See `device`.
     pub driver: String,
+    /// The thread counts the flight ran with (lavapipe's and rayon's).
     pub threads: Threads,
+    /// The thesis's stress test ([`FlightOptions::stress`]).
     pub stress: bool,
+    /// The descent to the ground ([`FlightOptions::descent`]).
     pub descent: bool,
     /// Whether the flight replayed a recorded camera path.
     pub recorded_path: bool,
+    /// The renderer's switches the flight ran with (each can be turned off for comparison).
     pub morphing: bool,
+    /// See `morphing`.
     pub parent_reuse: bool,
+    /// Frames the CPU may record ahead of the GPU.
     pub frames_in_flight: usize,
+    /// See `morphing`.
     pub atmosphere: bool,
+    /// See `morphing`.
     pub vertex_cache: bool,
+    /// See `morphing`.
     pub water_in_mesh: bool,
+    /// The level-of-detail rule.
     pub lod_rule: crate::config::LodRule,
+    /// The river model of the planet flown over.
     pub river_model: crate::config::RiverModel,
+    /// The planet's radius and seed.
     pub radius: f64,
+    /// See `radius`.
     pub seed: u32,
+    /// Width and height of the frames, pixels.
     pub resolution: [u32; 2],
+    /// Eq. 6.1's switch factor used.
     pub switch_factor: f32,
+    /// Every frame.
     pub frames: Vec<FlightFrame>,
     /// Frame time per frame of the flights in the other water modes.
     pub water_mode_frames: BTreeMap<String, Vec<f64>>,
+    /// Averages and maxima over the frames.
     pub summary: FlightSummary,
 }
 
 /// Options of a flight.
 #[derive(Clone, Debug)]
 pub struct FlightOptions {
+    /// Frames to fly.
     pub frames: u32,
     /// The thesis's stress test: switch factor x10 and camera x25 (overrides `speed`).
     pub stress: bool,
     /// Camera speed factor.
     pub speed: f64,
+    /// Width and height of the frames, pixels.
     pub size: [u32; 2],
     /// Run every frame's new river patches through all four kernel variants.
     pub compare_kernels: bool,

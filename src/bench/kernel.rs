@@ -27,24 +27,35 @@ use crate::{
 /// Kernel time of one variant: median over repetitions, and for the GPU the end-to-end time too.
 #[derive(Clone, Debug, Serialize)]
 pub struct VariantTiming {
+    /// The median of `runs_ms`.
     pub kernel_ms: f64,
+    /// GPU only: the median with the upload, the read-back and its decoding (docs/kernel.md).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_to_end_ms: Option<f64>,
+    /// Every repetition's time (the GPU's from timestamp queries).
     pub runs_ms: Vec<f64>,
 }
 
+/// The four ways the kernel runs: the CPU reference on one thread and on rayon's, the simple and the tiled GPU
+/// kernel (6.6-6.7).
 #[derive(Clone, Debug, Serialize)]
 pub struct Variants {
+    /// The CPU reference on one thread.
     pub cpu_single: VariantTiming,
+    /// The CPU reference on rayon's threads.
     pub cpu_rayon: VariantTiming,
+    /// The simple GPU kernel.
     pub gpu_simple: VariantTiming,
+    /// The tiled GPU kernel.
     pub gpu_tiled: VariantTiming,
 }
 
 /// Per-output differences of each GPU variant to the CPU reference (the worst over the repetitions).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct DiffsByVariant {
+    /// The simple kernel's, one per output.
     pub gpu_simple: Vec<OutputDiff>,
+    /// The tiled kernel's, one per output.
     pub gpu_tiled: Vec<OutputDiff>,
 }
 
@@ -59,6 +70,7 @@ impl DiffsByVariant {
     }
 }
 
+/// The variants' times against each other.
 #[derive(Clone, Debug, Serialize)]
 pub struct Ratios {
     /// GPU tiled kernel time / GPU simple kernel time (the thesis: 0.82 in Table 9.1, 0.68 in Table 9.2).
@@ -67,33 +79,51 @@ pub struct Ratios {
     pub cpu_single_over_gpu_tiled_end_to_end: f64,
     /// CPU single-threaded time / GPU tiled kernel time.
     pub cpu_single_over_gpu_tiled_kernel: f64,
+    /// CPU single-threaded time / CPU multi-threaded time.
     pub cpu_single_over_cpu_rayon: f64,
 }
 
+/// What `bench kernel` writes: the workload, the GPU variants' differences to the CPU reference, and every
+/// variant's time.
 #[derive(Clone, Debug, Serialize)]
 pub struct KernelReport {
+    /// The Vulkan device's name and its driver's name and version.
     pub device: String,
+    /// See `device`.
     pub driver: String,
+    /// The workload in words.
     pub workload: String,
+    /// Whether the flight was the thesis's stress test (switch factor x10, camera x25).
     pub stress: bool,
+    /// The planet's seed.
     pub seed: u32,
+    /// Frames of the scripted flight whose river patches make the workload.
     pub flight_frames: u32,
+    /// River patches in the workload, and their river samples in all.
     pub patches: usize,
+    /// See `patches`.
     pub samples: usize,
     /// Vertex-sample pairs the procedures visit.
     pub pairs: u64,
     /// Pairs within the influence distance: the ones Procedure 3 does real work for.
     pub relevant_pairs: u64,
+    /// The lowest and highest terrain height the CPU reference computed.
     pub height_range: [f32; 2],
+    /// The largest difference of any GPU output to the CPU reference.
     pub max_abs_diff: f32,
     /// `max_abs_diff` relative to the height range.
     pub relative_diff: f32,
     /// The largest difference to the CPU reference per output and GPU variant, with where it is.
     pub max_abs_diff_by_output: DiffsByVariant,
+    /// Runs of each variant.
     pub repetitions: usize,
+    /// The GPU kernels' workgroup shapes and tile size.
     pub tuning: KernelTuning,
+    /// The thread counts it ran with.
     pub threads: Threads,
+    /// Each variant's time.
     pub variants: Variants,
+    /// The times against each other.
     pub ratios: Ratios,
 }
 

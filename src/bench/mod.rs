@@ -16,12 +16,16 @@ use serde::Serialize;
 /// The thread settings a measurement ran with.
 #[derive(Clone, Debug, Serialize)]
 pub struct Threads {
+    /// `LP_NUM_THREADS` (lavapipe's rasterizer threads), where set.
     pub lp_num_threads: Option<String>,
+    /// `RAYON_NUM_THREADS`, where set.
     pub rayon_num_threads: Option<String>,
+    /// The threads rayon's pool has.
     pub rayon_threads_used: usize,
 }
 
 impl Threads {
+    /// The settings of this process.
     pub fn current() -> Self {
         Self {
             lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
