@@ -6,18 +6,36 @@ use std::path::Path;
 use plotters::prelude::*;
 use serde_json::Value;
 
+/// Why a plot was not drawn.
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
+    /// A report cannot be read.
     #[error("cannot read {path}: {message}")]
-    Read { path: String, message: String },
-    #[error("{path} is not a `{expected}` report: {message}")]
-    Format {
+    Read {
+        /// The report.
         path: String,
-        expected: &'static str,
+        /// The operating system's or the JSON parser's reason.
         message: String,
     },
+    /// A report is not the kind the plot needs.
+    #[error("{path} is not a `{expected}` report: {message}")]
+    Format {
+        /// The report.
+        path: String,
+        /// The command whose report it must be.
+        expected: &'static str,
+        /// What is missing or wrong.
+        message: String,
+    },
+    /// The figure cannot be drawn or written.
     #[error("cannot draw {path}: {message}")]
-    Draw { path: String, message: String },
+    Draw {
+        /// The figure's file.
+        path: String,
+        /// plotters' reason.
+        message: String,
+    },
+    /// The font is missing.
     #[error("no font for the plots: {0} (install fonts-dejavu-core)")]
     Font(String),
 }
@@ -38,7 +56,9 @@ fn register_font() -> Result<(), PlotError> {
 
 /// One line of a chart.
 pub struct Series {
+    /// The legend's name.
     pub name: String,
+    /// (x, y) in drawing order.
     pub points: Vec<(f64, f64)>,
 }
 

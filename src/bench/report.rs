@@ -13,10 +13,15 @@ fn f(v: &Value) -> f64 {
 
 /// The inputs of the report.
 pub struct ReportInputs<'a> {
+    /// `bench kernel`'s JSON.
     pub kernel: &'a Path,
+    /// `bench kernel --stress`'s JSON.
     pub kernel_stress: &'a Path,
+    /// `bench flight`'s JSON.
     pub flight: &'a Path,
+    /// `bench flight --stress`'s JSON.
     pub flight_stress: &'a Path,
+    /// A long flight's JSON (the memory bound), if one was flown.
     pub long_flight: Option<&'a Path>,
     /// The report of `bench kernel --parent-reuse`.
     pub kernel_reuse: Option<&'a Path>,

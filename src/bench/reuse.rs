@@ -28,31 +28,47 @@ use crate::{
 /// Kernel times (median over repetitions) of one way of computing the batch.
 #[derive(Clone, Debug, Serialize)]
 pub struct ReuseTiming {
+    /// The CPU reference on one thread.
     pub cpu_single_ms: f64,
+    /// The simple GPU kernel (timestamp queries).
     pub gpu_simple_ms: f64,
+    /// The tiled GPU kernel (timestamp queries).
     pub gpu_tiled_ms: f64,
     /// Vertices the kernel computes (the rest are copied).
     pub computed_vertices: u64,
 }
 
+/// What `bench kernel --parent-reuse` writes.
 #[derive(Clone, Debug, Serialize)]
 pub struct ReuseReport {
+    /// The Vulkan device's name and its driver's name and version.
     pub device: String,
+    /// See `device`.
     pub driver: String,
+    /// The workload in words.
     pub workload: String,
+    /// The planet's seed.
     pub seed: u32,
+    /// Frames of the descent whose patches make the workload.
     pub flight_frames: u32,
     /// Child patches in the batch, and the parents they take data from.
     pub patches: usize,
+    /// See `patches`.
     pub parents: usize,
+    /// River samples given to the kernel for the batch.
     pub samples: usize,
     /// Largest difference of any output between taking data from the parent and computing from scratch (CPU
     /// reference from scratch against the CPU and both GPU kernels with reuse).
     pub max_abs_diff: f32,
+    /// Runs of each way and variant.
     pub repetitions: usize,
+    /// The GPU kernels' workgroup shapes and tile size.
     pub tuning: KernelTuning,
+    /// The thread counts it ran with.
     pub threads: Threads,
+    /// Every patch computed from its samples.
     pub from_scratch: ReuseTiming,
+    /// The even vertices copied from the parent, the rest computed.
     pub from_parent: ReuseTiming,
     /// From scratch / from the parent, per variant (above 1: reuse is faster).
     pub speedup: [f64; 3],
