@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use super::{cube::FACES, heights::FaceLattice};
 
+mod lzw;
 mod read;
 use read::{bounds_beside, read_exr, read_png, read_tiff};
 

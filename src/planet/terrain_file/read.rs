@@ -16,6 +16,12 @@ pub(super) fn read_tiff(path: &Path) -> Result<(Heights, Option<Placement>), Str
     let mut decoder = Decoder::new(std::io::BufReader::new(file)).map_err(|e| e.to_string())?;
     let (width, height) = decoder.dimensions().map_err(|e| e.to_string())?;
     let placement = georeference(&mut decoder)?;
+    let compression: Option<u16> = decoder
+        .find_tag_unsigned(tiff::tags::Tag::Compression)
+        .map_err(|e| e.to_string())?;
+    if compression == Some(LZW) {
+        return Ok((read_lzw(&mut decoder, (width, height))?, placement));
+    }
     let heights = match decoder.read_image().map_err(|e| e.to_string())? {
         DecodingResult::F32(v) => v,
         DecodingResult::F64(v) => v.into_iter().map(|h| h as f32).collect(),
@@ -30,6 +36,133 @@ pub(super) fn read_tiff(path: &Path) -> Result<(Heights, Option<Placement>), Str
         }
     };
     Ok((one_channel(width, height, heights)?, placement))
+}
+
+/// TIFF's Compression tag for LZW.
+const LZW: u16 = 5;
+
+/// An LZW-compressed TIFF's heights, strip by strip or tile by tile (`lzw`): one channel of the sample types
+/// `read_tiff` takes, in chunky order.
+fn read_lzw<R: std::io::Read + std::io::Seek>(
+    decoder: &mut tiff::decoder::Decoder<R>,
+    (width, height): (u32, u32),
+) -> Result<Heights, String> {
+    use tiff::tags::Tag;
+    let mut unsigned = |tag: Tag| -> Result<Option<Vec<u64>>, String> {
+        decoder
+            .find_tag_unsigned_vec(tag)
+            .map_err(|e| e.to_string())
+    };
+    let first =
+        |v: Option<Vec<u64>>, default: u64| v.and_then(|v| v.first().copied()).unwrap_or(default);
+    let channels = first(unsigned(Tag::SamplesPerPixel)?, 1);
+    let bits = first(unsigned(Tag::BitsPerSample)?, 1);
+    let format = first(unsigned(Tag::SampleFormat)?, 1);
+    let predictor = first(unsigned(Tag::Predictor)?, 1) as u16;
+    if channels != 1 {
+        return Err(format!(
+            "{channels} samples per pixel: a terrain has one channel"
+        ));
+    }
+    let sample: fn(&[u8], bool) -> f32 = match (format, bits) {
+        (3, 32) => |b, little| f32::from_bits(word(b, little) as u32),
+        (3, 64) => |b, little| f64::from_bits(word(b, little)) as f32,
+        (2, 16) => |b, little| word(b, little) as u16 as i16 as f32,
+        (2, 32) => |b, little| word(b, little) as u32 as i32 as f32,
+        _ => {
+            return Err(format!(
+                "its samples are {bits}-bit of SampleFormat {format}; a TIFF's samples must be 32- or 64-bit floats \
+                 or 16- or 32-bit signed integers (heights as they are)"
+            ))
+        }
+    };
+    let bytes = bits as usize / 8;
+    // Tiles, or strips: chunks as wide as the image, RowsPerStrip tall (the last one cut at the image's end).
+    let tile_width = unsigned(Tag::TileWidth)?;
+    let tiled = tile_width.is_some();
+    let (chunk, offsets, counts) = match tile_width {
+        Some(tile_width) => (
+            (
+                first(Some(tile_width), 0),
+                first(unsigned(Tag::TileLength)?, 0),
+            ),
+            unsigned(Tag::TileOffsets)?,
+            unsigned(Tag::TileByteCounts)?,
+        ),
+        None => (
+            (
+                width as u64,
+                first(unsigned(Tag::RowsPerStrip)?, height as u64).min(height as u64),
+            ),
+            unsigned(Tag::StripOffsets)?,
+            unsigned(Tag::StripByteCounts)?,
+        ),
+    };
+    let (Some(offsets), Some(counts)) = (offsets, counts) else {
+        return Err("its strips' or tiles' offsets or byte counts are missing".into());
+    };
+    let (chunk_width, chunk_height) = (chunk.0 as usize, chunk.1 as usize);
+    if chunk_width == 0 || chunk_height == 0 {
+        return Err(
+            "its tiles or strips are empty (TileWidth, TileLength or RowsPerStrip 0)".into(),
+        );
+    }
+    let (width, height) = (width as usize, height as usize);
+    let across = width.div_ceil(chunk_width);
+    let chunks = across * height.div_ceil(chunk_height);
+    if offsets.len() < chunks || counts.len() < chunks {
+        return Err(format!(
+            "it has {} strip or tile offsets and {} byte counts for {chunks} strips or tiles",
+            offsets.len(),
+            counts.len()
+        ));
+    }
+    let little = decoder.byte_order() == tiff::tags::ByteOrder::LittleEndian;
+    let mut heights = vec![0.0f32; width * height];
+    for k in 0..chunks {
+        let (x0, y0) = ((k % across) * chunk_width, (k / across) * chunk_height);
+        // A strip holds only the image's rows; a tile is whole at the image's edges too.
+        let rows = match tiled {
+            true => chunk_height,
+            false => chunk_height.min(height - y0),
+        };
+        let mut data = vec![0u8; counts[k] as usize];
+        let reader = decoder.inner();
+        reader
+            .seek(std::io::SeekFrom::Start(offsets[k]))
+            .and_then(|_| reader.read_exact(&mut data))
+            .map_err(|e| format!("strip or tile {k}: {e}"))?;
+        let row_bytes = chunk_width * bytes;
+        let mut decoded = super::lzw::decode(&data, rows * row_bytes)
+            .map_err(|e| format!("strip or tile {k}: {e}"))?;
+        if decoded.len() < rows * row_bytes {
+            return Err(format!(
+                "its LZW strip or tile {k} ends after {} of {} bytes",
+                decoded.len(),
+                rows * row_bytes
+            ));
+        }
+        for (r, row) in decoded.chunks_exact_mut(row_bytes).enumerate() {
+            super::lzw::undo_predictor(predictor, row, bytes, little)?;
+            let y = y0 + r;
+            if y >= height {
+                break;
+            }
+            for (x, value) in (x0..width.min(x0 + chunk_width)).zip(row.chunks_exact(bytes)) {
+                heights[y * width + x] = sample(value, little);
+            }
+        }
+    }
+    Ok((width as u32, height as u32, heights))
+}
+
+/// Up to eight bytes as an unsigned number in the file's byte order.
+fn word(bytes: &[u8], little: bool) -> u64 {
+    let fold = |w: u64, b: &u8| w << 8 | *b as u64;
+    match little {
+        true => bytes.iter().rev().fold(0, fold),
+        false => bytes.iter().fold(0, fold),
+    }
 }
 
 /// GeoTIFF 1.1 (OGC 19-008): ModelPixelScale and one ModelTiepoint in a geographic model in degrees (GTModelType 2,
@@ -185,4 +318,135 @@ fn one_channel(width: u32, height: u32, heights: Vec<f32>) -> Result<Heights, St
         ));
     }
     Ok((width, height, heights))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn data(name: &str) -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name)
+    }
+
+    /// Written by libtiff (Pillow 13, `compression="tiff_lzw"` with the Predictor tag): 96 x 48 samples in strips of
+    /// 7 and 10 rows (the last one shorter), little-endian.
+    #[test]
+    fn lzw_tiffs_written_by_libtiff_read_as_their_heights() {
+        let formula =
+            |x: usize, y: usize| ((x * 37 + y * 101) % 1000) as f32 - 200.0 + 0.25 * x as f32;
+        let ((width, height, heights), placement) =
+            read_tiff(&data("lzw-float32-predictor3.tif")).unwrap();
+        assert_eq!((width, height), (96, 48));
+        for (k, h) in heights.iter().enumerate() {
+            assert_eq!(*h, formula(k % 96, k / 96), "float predictor, sample {k}");
+        }
+        let placement = placement.expect("its GeoTIFF tags place it");
+        assert_eq!(
+            (placement.west, placement.north, placement.degrees_per_pixel),
+            (10.0, 50.0, (0.5, 0.5))
+        );
+        let ((width, height, heights), placement) =
+            read_tiff(&data("lzw-int32-predictor2.tif")).unwrap();
+        assert_eq!((width, height), (96, 48));
+        assert!(placement.is_none());
+        for (k, h) in heights.iter().enumerate() {
+            let (x, y) = (k % 96, k / 96);
+            assert_eq!(
+                *h,
+                ((x * 37 + y * 101) % 3000) as f32 - 1000.0,
+                "horizontal predictor, sample {k}"
+            );
+        }
+    }
+
+    /// A big-endian tiled TIFF (16 x 16 tiles over 40 x 20 pixels, the edge tiles padded), floating-point
+    /// predictor: the tiles' layout and the byte order, which libtiff's strips above do not cover.
+    #[test]
+    fn a_big_endian_tiled_lzw_tiff_reads() {
+        let (width, height, tile) = (40usize, 20usize, 16usize);
+        let value = |x: usize, y: usize| x as f32 * 1.5 - y as f32 * 2.25 + 0.125;
+        let (across, down) = (width.div_ceil(tile), height.div_ceil(tile));
+        let mut tiles = Vec::new();
+        for t in 0..across * down {
+            let (x0, y0) = ((t % across) * tile, (t / across) * tile);
+            let mut bytes = Vec::new();
+            for y in y0..y0 + tile {
+                let row: Vec<f32> = (x0..x0 + tile)
+                    .map(|x| {
+                        if x < width && y < height {
+                            value(x, y)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                // The floating-point predictor: byte planes, most significant first, then differences.
+                let planes: Vec<u8> = (0..4)
+                    .flat_map(|b| row.iter().map(move |v| v.to_be_bytes()[b]))
+                    .collect();
+                bytes.extend(
+                    (0..planes.len())
+                        .map(|k| planes[k].wrapping_sub(if k == 0 { 0 } else { planes[k - 1] })),
+                );
+            }
+            tiles.push(super::super::lzw::tests::encode(&bytes));
+        }
+        // Header, tiles, the offsets and byte counts, then the directory.
+        let mut file = b"MM\0\x2a\0\0\0\0".to_vec();
+        let mut offsets = Vec::new();
+        for t in &tiles {
+            offsets.push(file.len() as u32);
+            file.extend(t);
+        }
+        let long_array = |file: &mut Vec<u8>, values: &[u32]| {
+            let at = file.len() as u32;
+            file.extend(values.iter().flat_map(|v| v.to_be_bytes()));
+            at
+        };
+        let counts: Vec<u32> = tiles.iter().map(|t| t.len() as u32).collect();
+        let offsets_at = long_array(&mut file, &offsets);
+        let counts_at = long_array(&mut file, &counts);
+        let directory = file.len() as u32;
+        file[4..8].copy_from_slice(&directory.to_be_bytes());
+        let (short, long) = (3u16, 4u16);
+        let entries: [(u16, u16, u32, u32); 12] = [
+            (256, long, 1, width as u32),
+            (257, long, 1, height as u32),
+            (258, short, 1, 32),
+            (259, short, 1, 5),
+            (262, short, 1, 1),
+            (277, short, 1, 1),
+            (317, short, 1, 3),
+            (322, long, 1, tile as u32),
+            (323, long, 1, tile as u32),
+            (324, long, tiles.len() as u32, offsets_at),
+            (325, long, tiles.len() as u32, counts_at),
+            (339, short, 1, 3),
+        ];
+        file.extend((entries.len() as u16).to_be_bytes());
+        for (tag, kind, count, value) in entries {
+            file.extend(tag.to_be_bytes());
+            file.extend(kind.to_be_bytes());
+            file.extend(count.to_be_bytes());
+            // A short value fills the field's first two bytes.
+            match (kind, count) {
+                (3, 1) => file.extend([(value as u16).to_be_bytes(), [0, 0]].concat()),
+                _ => file.extend(value.to_be_bytes()),
+            }
+        }
+        file.extend(0u32.to_be_bytes());
+        let path =
+            std::env::temp_dir().join(format!("riverplanet-tiled-lzw-{}.tif", std::process::id()));
+        std::fs::write(&path, &file).unwrap();
+        let read = read_tiff(&path);
+        std::fs::remove_file(&path).unwrap();
+        let ((w, h, heights), placement) = read.unwrap();
+        assert_eq!((w, h), (width as u32, height as u32));
+        assert!(placement.is_none());
+        for (k, v) in heights.iter().enumerate() {
+            assert_eq!(*v, value(k % width, k / width), "sample {k}");
+        }
+    }
 }
