@@ -40,6 +40,8 @@ pub(super) fn read_tiff(path: &Path) -> Result<(Heights, Option<Placement>), Str
 
 /// TIFF's Compression tag for LZW.
 const LZW: u16 = 5;
+/// The most bytes an LZW TIFF may decode to: the tiff crate's default limit for the other compressions.
+const DECODED_LIMIT: usize = 256 << 20;
 
 /// An LZW-compressed TIFF's heights, strip by strip or tile by tile (`lzw`): one channel of the sample types
 /// `read_tiff` takes, in chunky order.
@@ -77,6 +79,12 @@ fn read_lzw<R: std::io::Read + std::io::Seek>(
         }
     };
     let bytes = bits as usize / 8;
+    if width as usize * height as usize * bytes > DECODED_LIMIT {
+        return Err(format!(
+            "{width}x{height} samples of {bytes} bytes exceed the {} MiB a TIFF may decode to",
+            DECODED_LIMIT >> 20
+        ));
+    }
     // Tiles, or strips: chunks as wide as the image, RowsPerStrip tall (the last one cut at the image's end).
     let tile_width = unsigned(Tag::TileWidth)?;
     let tiled = tile_width.is_some();
@@ -108,6 +116,16 @@ fn read_lzw<R: std::io::Read + std::io::Seek>(
         );
     }
     let (width, height) = (width as usize, height as usize);
+    // TIFF 6.0 pads tiles to multiples of 16; more than that is no tiling of this image.
+    if chunk_width > width.next_multiple_of(16) || chunk_height > height.next_multiple_of(16) {
+        return Err(format!(
+            "its {chunk_width}x{chunk_height} tiles are larger than its {width}x{height} image"
+        ));
+    }
+    let file_length = decoder
+        .inner()
+        .seek(std::io::SeekFrom::End(0))
+        .map_err(|e| e.to_string())?;
     let across = width.div_ceil(chunk_width);
     let chunks = across * height.div_ceil(chunk_height);
     if offsets.len() < chunks || counts.len() < chunks {
@@ -126,6 +144,12 @@ fn read_lzw<R: std::io::Read + std::io::Seek>(
             true => chunk_height,
             false => chunk_height.min(height - y0),
         };
+        if offsets[k].saturating_add(counts[k]) > file_length {
+            return Err(format!(
+                "its strip or tile {k} ({} bytes at {}) reaches past the file's end ({file_length} bytes)",
+                counts[k], offsets[k]
+            ));
+        }
         let mut data = vec![0u8; counts[k] as usize];
         let reader = decoder.inner();
         reader
@@ -362,7 +386,8 @@ mod tests {
     }
 
     /// A big-endian tiled TIFF (16 x 16 tiles over 40 x 20 pixels, the edge tiles padded), floating-point
-    /// predictor: the tiles' layout and the byte order, which libtiff's strips above do not cover.
+    /// predictor: the tiles' layout and the byte order, which libtiff's strips above do not cover; and the same
+    /// file made hostile.
     #[test]
     fn a_big_endian_tiled_lzw_tiff_reads() {
         let (width, height, tile) = (40usize, 20usize, 16usize);
@@ -437,12 +462,31 @@ mod tests {
             }
         }
         file.extend(0u32.to_be_bytes());
-        let path =
-            std::env::temp_dir().join(format!("riverplanet-tiled-lzw-{}.tif", std::process::id()));
-        std::fs::write(&path, &file).unwrap();
-        let read = read_tiff(&path);
-        std::fs::remove_file(&path).unwrap();
-        let ((w, h, heights), placement) = read.unwrap();
+        let read = |file: &[u8]| {
+            let path = std::env::temp_dir()
+                .join(format!("riverplanet-tiled-lzw-{}.tif", std::process::id()));
+            std::fs::write(&path, file).unwrap();
+            let read = read_tiff(&path);
+            std::fs::remove_file(&path).unwrap();
+            read
+        };
+        // A hostile file is refused before it allocates what it claims: a tile's byte count past the file's end,
+        // tiles larger than the image.
+        let mut bad = file.clone();
+        bad[counts_at as usize..counts_at as usize + 4]
+            .copy_from_slice(&0xffff_fff0u32.to_be_bytes());
+        let err = read(&bad).unwrap_err();
+        assert!(err.contains("past the file's end"), "{err}");
+        let mut bad = file.clone();
+        let field = |entry: usize, at: usize| directory as usize + 2 + entry * 12 + at;
+        bad[field(7, 8)..field(7, 12)].copy_from_slice(&(1u32 << 30).to_be_bytes());
+        // One tile across then: two offsets and byte counts, as the tile count the decoder checks.
+        for entry in [9, 10] {
+            bad[field(entry, 4)..field(entry, 8)].copy_from_slice(&2u32.to_be_bytes());
+        }
+        let err = read(&bad).unwrap_err();
+        assert!(err.contains("larger than its 40x20 image"), "{err}");
+        let ((w, h, heights), placement) = read(&file).unwrap();
         assert_eq!((w, h), (width as u32, height as u32));
         assert!(placement.is_none());
         for (k, v) in heights.iter().enumerate() {
