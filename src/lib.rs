@@ -10,6 +10,9 @@
 //! - model: `planet`, `river`, `config`, `rng`;
 //! - `gpu`: the only module that imports ash; it knows nothing of planets.
 
+// Every public item says what it is for (issue "Your own terrain, your own program": the planet as a library).
+#![warn(missing_docs)]
+
 pub mod bench;
 pub mod config;
 pub mod drainage;

@@ -22,8 +22,11 @@ pub const HEIGHT_FORMAT: Format = Format::R32_SFLOAT;
 /// A patch to refine: its id, the slot its fresh texture is bound at, and its parent's slot.
 #[derive(Clone, Copy, Debug)]
 pub struct RefineJob {
+    /// The patch.
     pub patch: PatchId,
+    /// Where its fresh height texture is bound.
     pub slot: Slot,
+    /// Where its parent's is.
     pub parent_slot: Slot,
 }
 
@@ -66,6 +69,7 @@ pub struct HeightRefiner {
 }
 
 impl HeightRefiner {
+    /// The refinement pipeline for patches of `vertices` a side.
     pub fn new(ctx: &Context, bindless: &Bindless, vertices: u32) -> Result<Self, GpuError> {
         let jobs_layout = BufferSetLayout::new(ctx, 2, "height refinement jobs and ranges")?;
         let pipeline = ComputePipeline::new(

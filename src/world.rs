@@ -6,10 +6,15 @@ use crate::{
     river::network::RiverNetwork,
 };
 
+/// A planet and its river network, from one configuration and seed.
 pub struct World {
+    /// The configuration it was built from.
     pub config: Config,
+    /// The seed.
     pub seed: u32,
+    /// The planet: base lattice, precomputed heights, drainage.
     pub planet: Planet,
+    /// Its rivers.
     pub network: RiverNetwork,
 }
 

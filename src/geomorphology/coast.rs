@@ -43,6 +43,7 @@ impl LandMask {
         Self::with_width(MASK_WIDTH, is_land)
     }
 
+    /// Samples `is_land` at every pixel centre of a mask `width` pixels wide (and half as high).
     pub fn with_width(width: usize, is_land: impl Fn(DVec3) -> bool + Sync) -> Self {
         let height = width / 2;
         let mut mask = Self {
@@ -83,6 +84,7 @@ impl LandMask {
         margin..self.height - margin
     }
 
+    /// The coast's box-counting dimension and longest straight run (docs/geomorphology.md).
     pub fn measure(&self) -> CoastMeasures {
         CoastMeasures {
             coast_dimension: self.box_dimension(),

@@ -21,6 +21,7 @@ pub const BAND_EDGES: [f64; 3] = [0.125, 0.25, 0.375];
 /// What stats.json reports of a planet's form.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct WorldMeasures {
+    /// The coast's measures.
     #[serde(flatten)]
     pub coast: CoastMeasures,
     /// Share of the land area (percent) whose height above sea level lies in each band of

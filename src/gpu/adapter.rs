@@ -13,12 +13,19 @@ use super::{
 /// What `riverplanet info` shows of one physical device.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct AdapterInfo {
+    /// The device's name (`deviceName`).
     pub name: String,
+    /// Discrete, integrated, virtual or CPU.
     pub device_type: String,
+    /// The Vulkan version it supports, major.minor.patch.
     pub api_version: String,
+    /// The driver's name and what it says of its version (`VK_KHR_driver_properties`).
     pub driver_name: String,
+    /// See `driver_name`.
     pub driver_info: String,
+    /// Which of the features the renderer needs or uses it has.
     pub features: FeatureReport,
+    /// Whether the renderer picks this device.
     pub chosen: bool,
 }
 

@@ -13,13 +13,20 @@ use super::{
 /// The debug name of the set, which validation messages quote.
 pub(crate) const SET_NAME: &str = "bindless set";
 
+/// The set's binding of storage-image views (what compute passes write).
 pub const STORAGE_IMAGES: u32 = 0;
+/// The set's binding of sampled views of the same slots (what shaders read).
 pub const SAMPLED_IMAGES: u32 = 1;
 
+/// One descriptor set of image slots every pipeline binds, indexed by slot number in the shaders
+/// (descriptor indexing): a patch texture takes a slot instead of a descriptor set of its own.
 pub struct Bindless {
+    /// The set's layout, shared by every pipeline layout.
     pub layout: vk::DescriptorSetLayout,
+    /// The set.
     pub set: vk::DescriptorSet,
     sampler: vk::Sampler,
+    /// Slots in all.
     pub capacity: u32,
     free: Vec<u32>,
     /// Released slots with the timeline value after which no submitted frame reads them: a frame still in

@@ -311,6 +311,7 @@ impl Recorder<'_> {
         }
     }
 
+    /// Ends the dynamic rendering `begin_rendering` opened.
     pub fn end_rendering(&mut self) {
         // SAFETY: paired with begin_rendering.
         unsafe { self.ctx().device.cmd_end_rendering(self.cmd) };

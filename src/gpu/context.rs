@@ -25,16 +25,21 @@ pub struct Context {
     pub(super) debug_device: Option<ext::debug_utils::Device>,
     pub(super) physical: vk::PhysicalDevice,
     pub(super) device: ash::Device,
+    /// The queue family of the one queue, which does graphics, compute and transfers.
     pub queue_family: u32,
     queue: Mutex<vk::Queue>,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) deletion: std::sync::Arc<DeletionQueue>,
     pub(crate) timeline: Timeline,
+    /// The device's properties and limits.
     pub properties: vk::PhysicalDeviceProperties,
+    /// Its subgroups' size and operations.
     pub subgroup: features::SubgroupProperties,
+    /// The bits of the queue's timestamps that count (0: no timestamps).
     pub timestamp_valid_bits: u32,
     pub(super) validation_log: Box<ValidationLog>,
     pub(super) validation_enabled: bool,
+    /// What `riverplanet info` shows of the device.
     pub adapter: AdapterInfo,
 }
 

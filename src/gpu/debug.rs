@@ -163,6 +163,7 @@ impl Context {
         unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
     }
 
+    /// Closes the label `begin_label` opened (nothing without the debug-utils extension).
     pub fn end_label(&self, cmd: vk::CommandBuffer) {
         if let Some(debug) = &self.debug_device {
             // SAFETY: paired with begin_label on a recording command buffer.

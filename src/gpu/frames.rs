@@ -22,8 +22,11 @@ pub const MAX_FRAMES_IN_FLIGHT: usize = 3;
 
 /// What a finished frame left behind: its GPU timings and the caller's payload.
 pub struct Finished<T> {
+    /// The frame's submission.
     pub submission: SubmissionId,
+    /// Its profiler scopes' GPU times.
     pub timings: Vec<ScopeTiming>,
+    /// What the caller handed in with the frame.
     pub payload: T,
 }
 

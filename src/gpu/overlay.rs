@@ -9,6 +9,7 @@ use super::{
     frames::MAX_FRAMES_IN_FLIGHT, submit::transient_command_pool, vk, Context, GpuError, Recorder,
 };
 
+/// Draws the viewer's egui overlay (egui-ash-renderer) into a target, uploading its textures on its own pool.
 pub struct OverlayRenderer {
     renderer: Renderer,
     pool: vk::CommandPool,

@@ -12,10 +12,13 @@ use super::{
 /// The GPU time of one named scope.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct ScopeTiming {
+    /// The scope's name (a pass, or a kernel stage).
     pub name: String,
+    /// Between its begin and end timestamps, milliseconds.
     pub ms: f64,
 }
 
+/// Timestamp queries around named scopes of a recording, read back once its submission has finished.
 pub struct Profiler {
     pool: vk::QueryPool,
     capacity: u32,

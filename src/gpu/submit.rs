@@ -157,6 +157,7 @@ impl<'a> Recorder<'a> {
         begun.map(|()| recorder)
     }
 
+    /// The context it records for.
     pub fn ctx(&self) -> &'a Context {
         self.ctx
     }
@@ -269,6 +270,7 @@ impl<'a> Recorder<'a> {
         Ok(SubmissionId(value))
     }
 
+    /// Submits the recording, waiting on nothing and signalling only the timeline.
     pub fn submit(self) -> Result<SubmissionId, GpuError> {
         self.submit_with(&[], &[])
     }

@@ -21,6 +21,7 @@ pub fn surface_extensions(display: RawDisplayHandle) -> Result<Vec<&'static CStr
         .collect())
 }
 
+/// A window's Vulkan surface.
 pub struct Surface {
     loader: khr::surface::Instance,
     raw: vk::SurfaceKHR,
@@ -53,12 +54,14 @@ impl Surface {
         Ok(Self { loader, raw })
     }
 
+    /// Destroys the surface; its swapchain must be destroyed first.
     pub fn destroy(self) {
         // SAFETY: the swapchain using it was destroyed first.
         unsafe { self.loader.destroy_surface(self.raw, None) };
     }
 }
 
+/// The images a window presents, with their views and what each was last used for.
 pub struct Swapchain {
     loader: khr::swapchain::Device,
     raw: vk::SwapchainKHR,
@@ -66,7 +69,9 @@ pub struct Swapchain {
     views: Vec<vk::ImageView>,
     /// What each image was last recorded for (gpu/state.rs).
     states: Vec<Arc<UseState>>,
+    /// The images' format and size.
     pub format: vk::Format,
+    /// See `format`.
     pub extent: vk::Extent2D,
     /// Acquire semaphores, used in turn: one more than the most frames in flight, so the one acquired next is never
     /// still awaited by a queued frame.

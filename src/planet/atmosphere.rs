@@ -13,7 +13,9 @@ pub struct Atmosphere {
     pub bottom: f64,
     /// Radius of the top of the shell.
     pub top: f64,
+    /// Scale heights of the molecules' and the aerosols' density (which falls by e over each).
     pub rayleigh_height: f64,
+    /// See `rayleigh_height`.
     pub mie_height: f64,
     /// Rayleigh scattering (= extinction) per unit length at the bottom, for red, green and blue.
     pub rayleigh: [f64; 3],
@@ -26,8 +28,11 @@ pub struct Atmosphere {
 /// The transmittance from every altitude along every direction to the top of the shell (zero where the ray meets
 /// the ground), RGBA32F texels (alpha 1), row-major, [`air::TRANSMITTANCE_SIZE`].
 pub struct TransmittanceTable {
+    /// Texels across (directions) and down (altitudes).
     pub width: u32,
+    /// See `width`.
     pub height: u32,
+    /// The texels, row-major.
     pub texels: Vec<[f32; 4]>,
 }
 

@@ -49,6 +49,7 @@ pub fn lattice_hash(seed: u32, level: u32, key: [u32; 3]) -> u32 {
 /// follows the ground's slope.
 #[derive(Clone, Copy, Debug)]
 pub struct DetailRule {
+    /// The planet's seed, from which every displacement hashes.
     pub seed: u32,
     /// `detail-amplitude`: the displacement of points created at level 0; level L gets `2^-L` of it.
     pub amplitude: f32,
@@ -196,9 +197,11 @@ pub fn corner_of(cells: i64, (gi, gj): (i64, i64)) -> (i64, i64) {
 /// (i, j) of the patch (i, j in [-BORDER, n - 1 + BORDER]) is at `(j + BORDER) * side + i + BORDER`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PatchHeights {
+    /// The patch.
     pub patch: PatchId,
     /// Vertices per patch edge.
     pub n: u32,
+    /// The heights, as above.
     pub data: Vec<f32>,
 }
 

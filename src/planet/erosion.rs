@@ -69,6 +69,7 @@ const PEAK_QUANTILE: f64 = 0.999;
 /// What the evolution reached, for stats.json.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct ErosionReport {
+    /// Time steps run.
     pub steps: usize,
     /// Largest height change of the last step relative to the highest land (0 at the steady state).
     pub last_change: f64,

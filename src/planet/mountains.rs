@@ -11,11 +11,15 @@ const STREAM_MOUNTAINS: u64 = 0x40_0001;
 /// A mountain of Section 4.2: the 3x3 mask's centre, kept as a river source.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Mountain {
+    /// The cube face it stands on.
     pub face: usize,
     /// Position on the base lattice.
     pub i: u32,
+    /// See `i`.
     pub j: u32,
+    /// Its direction from the planet's centre (unit).
     pub direction: [f64; 3],
+    /// Its height on the base lattice.
     pub height: f32,
 }
 

@@ -72,11 +72,14 @@ pub fn shelf(planet: &PlanetConfig, to_land: f64) -> f64 {
 /// Distances along the grid (radians) of every land node from the nearest sea node, and of every sea node from
 /// the nearest land node.
 pub struct CoastDistances {
+    /// Per node: from a land node to the nearest sea node (0 at sea).
     pub to_sea: Vec<f64>,
+    /// Per node: from a sea node to the nearest land node (0 on land).
     pub to_land: Vec<f64>,
 }
 
 impl CoastDistances {
+    /// Both distances on `grid` for the nodes `land` marks, along the grid from the nodes beside the coast.
     pub fn new(grid: &SphereGrid, land: &[bool]) -> Self {
         let coast = |is_land: bool| -> Vec<u32> {
             (0..grid.len() as u32)

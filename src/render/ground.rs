@@ -12,12 +12,14 @@ use crate::{
     world::World,
 };
 
+/// The drawn surface's patch under the camera, made on the CPU when the camera enters it.
 pub struct Ground {
     level: u8,
     patch: Option<CarvedPatch>,
 }
 
 impl Ground {
+    /// Patches of `world`'s finest drawn level, none made yet.
     pub fn new(world: &World) -> Self {
         Self {
             level: world.config.rendering.max_level_of_detail as u8,

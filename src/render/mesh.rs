@@ -29,7 +29,9 @@ pub struct QuadrantMesh {
 /// The index buffer and the ranges of each quadrant in it (bit 0: +i half, bit 1: +j half). The whole buffer is
 /// every triangle at least once (midline skirts twice).
 pub struct PatchMesh {
+    /// Every quadrant's indices, one after the other.
     pub indices: Vec<u32>,
+    /// Where each quadrant's cells and skirts lie in `indices`.
     pub quadrants: [QuadrantMesh; 4],
 }
 

@@ -20,13 +20,19 @@ use crate::{
 
 /// What the overlay shows that the renderer does not hold.
 pub struct ViewInfo {
+    /// The planet's seed.
     pub seed: u32,
+    /// The camera's height above the drawn surface.
     pub altitude: f64,
+    /// Flying or orbiting.
     pub mode: CameraMode,
+    /// The last frame's time, milliseconds.
     pub frame_ms: f64,
 }
 
+/// The viewer's egui panel: what is drawn and how fast, the switches, the keys.
 pub struct Overlay {
+    /// Shown (U toggles it).
     pub visible: bool,
     egui: egui::Context,
     input: egui_winit::State,
@@ -41,6 +47,7 @@ const KEYS: &str = "W/S A/D Q/E move, arrows or drag look (orbit: drag turns the
                     K kernel, Esc quit";
 
 impl Overlay {
+    /// The panel for `window`, drawn into targets of `color` and `depth`.
     pub fn new(
         ctx: &Context,
         window: &Window,

@@ -11,6 +11,7 @@ use crate::{
     world::World,
 };
 
+/// The cameras `render --preset` and the README's pictures use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
     /// The whole planet from orbit, centred on the first river.

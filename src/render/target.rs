@@ -5,12 +5,16 @@ use crate::gpu::{
     ImageDesc, MemoryLocation, Recorder,
 };
 
+/// The offscreen targets' colour format.
 pub const COLOR_FORMAT: Format = Format::R8G8B8A8_UNORM;
+/// Every target's depth format (reversed Z, runtime/camera.rs).
 pub const DEPTH_FORMAT: Format = Format::D32_SFLOAT;
 
 /// Colour and depth images of one size.
 pub struct Offscreen {
+    /// The colour image.
     pub color: Image,
+    /// The depth image.
     pub depth: Image,
 }
 
@@ -40,6 +44,7 @@ impl Offscreen {
         Ok(Self { color, depth })
     }
 
+    /// The two images as a target cleared to `clear_color`.
     pub fn target(&self, clear_color: [f32; 4]) -> RenderTarget {
         RenderTarget::new(&self.color, &self.depth, clear_color)
     }

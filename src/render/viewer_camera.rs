@@ -27,13 +27,18 @@ const ZOOM_STEP: f64 = 0.15;
 /// planet, where the orbit mode starts, has a steady orientation.
 #[derive(Clone, Copy, Debug)]
 pub struct ViewerCamera {
+    /// Where the camera is (planet centre at the origin).
     pub position: DVec3,
+    /// Where it looks (unit).
     pub forward: DVec3,
+    /// The screen's up (unit, orthogonal to `forward`).
     pub up: DVec3,
+    /// Flying or orbiting.
     pub mode: CameraMode,
 }
 
 impl ViewerCamera {
+    /// At `eye` looking at `target`, levelled to the planet's horizon.
     pub fn new(eye: DVec3, target: DVec3, mode: CameraMode) -> Self {
         let forward = (target - eye).normalize();
         let mut camera = Self {
@@ -46,6 +51,7 @@ impl ViewerCamera {
         camera
     }
 
+    /// The screen's right (unit).
     pub fn right(&self) -> DVec3 {
         self.forward.cross(self.up).normalize()
     }

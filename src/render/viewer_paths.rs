@@ -10,6 +10,7 @@ use glam::DVec3;
 use super::viewer_camera::{CameraMode, ViewerCamera};
 use crate::runtime::camera_path::{CameraPath, PathFrame};
 
+/// The recording and the bookmarks of one viewer run.
 pub struct ViewerPaths {
     record: Option<(PathBuf, CameraPath)>,
     bookmarks_file: PathBuf,

@@ -25,13 +25,18 @@ const MAX_RIVER_ANGLE: f64 = 0.6;
 /// All river systems of a planet.
 #[derive(Clone, Debug)]
 pub struct RiverNetwork {
+    /// Every river system (a river from its mouth with its tributaries, 5.1).
     pub systems: Vec<RiverSystem>,
     /// The streams finer levels add (drainage model, beyond the thesis; docs/rivers.md "Rivers at every scale"),
     /// coarsest level first: they influence patches of their level and finer.
     pub streams: Vec<StreamLevel>,
+    /// How segments are subdivided as the levels grow (5.2).
     pub params: SubdivisionParams,
+    /// Subdivision levels included in each river's convex hull (5.2.3).
     pub hull_levels: u32,
+    /// How far from a river its samples shape the terrain (Procedure 3).
     pub influence_distance: f64,
+    /// Samples per half river width (6.4).
     pub samples_per_half_width: u32,
     /// At most this many samples per vertex spacing (0: no limit; `samples-per-vertex-spacing`).
     pub samples_per_vertex_spacing: u32,

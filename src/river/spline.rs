@@ -6,9 +6,13 @@ use glam::DVec2;
 /// A cubic Hermite segment: end points and tangents (3.8.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hermite {
+    /// The start point and the tangent there.
     pub p0: DVec2,
+    /// See `p0`.
     pub d0: DVec2,
+    /// The end point and the tangent there.
     pub p1: DVec2,
+    /// See `p1`.
     pub d1: DVec2,
 }
 
@@ -35,6 +39,7 @@ impl Hermite {
             + self.d1 * (3.0 * t2 - 2.0 * t)
     }
 
+    /// The same curve as a Bézier (control points a third of the tangents from the ends).
     pub fn to_bezier(&self) -> Bezier {
         Bezier([
             self.p0,
@@ -86,6 +91,7 @@ impl Bezier {
         (p1 - p0) * (3.0 * s * s) + (p2 - p1) * (6.0 * s * t) + (p3 - p2) * (3.0 * t * t)
     }
 
+    /// The same curve as a Hermite segment.
     pub fn to_hermite(&self) -> Hermite {
         let [p0, p1, p2, p3] = self.0;
         Hermite {

@@ -15,11 +15,13 @@ struct Entry<D> {
 /// Resident patches with payload `D`, with LRU eviction beyond `capacity` patches.
 pub struct PatchCache<D> {
     entries: HashMap<PatchId, Entry<D>>,
+    /// Patches held at most.
     pub capacity: usize,
     frame: u64,
 }
 
 impl<D> PatchCache<D> {
+    /// An empty cache of `capacity` patches (at least the six roots).
     pub fn new(capacity: usize) -> Self {
         Self {
             entries: HashMap::new(),
@@ -33,6 +35,7 @@ impl<D> PatchCache<D> {
         self.frame += 1;
     }
 
+    /// Whether `patch` is resident (without marking it used).
     pub fn contains(&self, patch: &PatchId) -> bool {
         self.entries.contains_key(patch)
     }
@@ -89,10 +92,12 @@ impl<D> PatchCache<D> {
         None
     }
 
+    /// Resident patches.
     pub fn len(&self) -> usize {
         self.entries.len()
     }
 
+    /// Whether none is resident.
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }

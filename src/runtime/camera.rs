@@ -4,8 +4,10 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
+/// A view of the planet: where from, where to, and the perspective.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// The eye (planet centre at the origin).
     pub position: DVec3,
     /// Unit view direction.
     pub forward: DVec3,
@@ -13,7 +15,9 @@ pub struct Camera {
     pub up: DVec3,
     /// Vertical field of view, radians.
     pub fov_y: f64,
+    /// Width over height of the viewport.
     pub aspect: f64,
+    /// The near plane's distance (`near_plane`).
     pub near: f64,
 }
 

@@ -49,7 +49,9 @@ impl Frustum {
 /// Heights every point of the planet lies between (base terrain and rivers).
 #[derive(Clone, Copy, Debug)]
 pub struct HeightRange {
+    /// The lowest, above the sphere of the planet's radius (negative below it).
     pub min: f64,
+    /// The highest.
     pub max: f64,
 }
 

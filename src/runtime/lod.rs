@@ -17,7 +17,9 @@ use crate::planet::{
 /// patches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Selected {
+    /// The patch.
     pub patch: PatchId,
+    /// Its quadrants drawn, as above.
     pub quadrants: u8,
 }
 
@@ -61,6 +63,7 @@ pub fn painted_bank_error(spacing: f64, half_width: f64) -> f64 {
 pub struct LodParams {
     /// The planet's radius: distances are measured to patches on this sphere.
     pub radius: f64,
+    /// No patch finer than this level is selected.
     pub max_level: u32,
     switch: Switch,
 }

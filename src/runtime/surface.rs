@@ -27,9 +27,13 @@ use crate::{
 /// far inside a river's basin the vertex lies (half width - |signed distance|; positive inside, as the geometry
 /// shader's test).
 pub struct CarvedPatch {
+    /// The patch.
     pub patch: PatchId,
+    /// Per vertex (row-major), the drawn terrain's height.
     pub terrain: Vec<f32>,
+    /// Per vertex, the water's height.
     pub water: Vec<f32>,
+    /// Per vertex, how far inside a river's basin it lies.
     pub basin: Vec<f32>,
 }
 

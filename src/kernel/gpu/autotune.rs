@@ -26,7 +26,9 @@ use crate::{
 /// Which kernel variant to run: the faster one measured on the device (the renderer's default), or one named.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KernelChoice {
+    /// The faster variant measured on this device (and cached per device and driver).
     Auto,
+    /// This variant.
     Fixed(KernelVariant),
 }
 
@@ -41,10 +43,13 @@ impl Named for KernelChoice {
 /// The device's measured choice: the fastest tiled shape, and the faster of the two variants with it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Tuned {
+    /// The fastest tiled shape.
     pub tuning: KernelTuning,
+    /// The faster variant with it.
     pub variant: KernelVariant,
     /// Median kernel time of the synthetic workload (below), simple kernel and best tiled shape.
     pub simple_ms: f64,
+    /// See `simple_ms`.
     pub tiled_ms: f64,
 }
 

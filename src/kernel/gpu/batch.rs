@@ -33,8 +33,11 @@ pub fn decode_texels(bytes: &[u8], grid_size: u32) -> Vec<RiverTexel> {
 
 /// The result of [`run_batch`]: texels per patch and the GPU times of the scopes.
 pub struct BatchResult {
+    /// Per patch, its texels read back.
     pub texels: Vec<Vec<RiverTexel>>,
+    /// The kernel's scopes' GPU times.
     pub timings: Vec<ScopeTiming>,
+    /// Bytes of the batch's temporary buffers (samples, range table, reach masks).
     pub temporary_bytes: u64,
 }
 

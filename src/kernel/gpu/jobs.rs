@@ -24,9 +24,11 @@ impl GpuPatchJob {
 /// The rows of a batch (patches computed from scratch first, then the four rows of each patch that takes river
 /// data from its parent) and where each patch's samples start in the sample buffer.
 pub struct RangeTable {
+    /// One per dispatched grid of vertices.
     pub rows: Vec<GpuPatchJob>,
     /// Rows over all vertices of a patch (the first ones); the rest cover every second vertex.
     pub full_rows: usize,
+    /// Per patch, the index of its first sample in the sample buffer.
     pub sample_offsets: Vec<u32>,
     /// Reach-mask words of all rows, with blocks of `block` vertices.
     pub mask_words: u64,

@@ -37,6 +37,7 @@ pub enum KernelVariant {
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
 /// minimum distance), layer 1 = (river half width, 0, 0, 0).
 pub const RIVER_TEXTURE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
+/// See `RIVER_TEXTURE_FORMAT`.
 pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 
 /// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
@@ -44,9 +45,13 @@ pub const RIVER_TEXTURE_LAYERS: u32 = 2;
 /// (its river texture in the GENERAL layout) and quadrant. `parents` is empty or as long as `jobs`.
 #[derive(Clone, Copy)]
 pub struct KernelBatch<'a> {
+    /// Per job, the river texture it writes.
     pub textures: &'a [&'a Image],
+    /// Per job, that texture's bindless slot.
     pub slots: &'a [Slot],
+    /// The patches, with their vertex spacing and samples.
     pub jobs: &'a [PatchJob<'a>],
+    /// Per job, its parent's slot and the quadrant it covers of it, where it takes its even vertices from there.
     pub parents: &'a [Option<(Slot, ParentQuadrant)>],
     /// The river textures those parents' slots hold (each once): the dispatch reads them.
     pub parent_textures: &'a [&'a Image],
@@ -61,11 +66,15 @@ pub struct RiverKernel {
     /// Samples and range table (simple); plus the reach masks (reach pre-pass and tiled).
     inputs: BufferSetLayout,
     tiled_inputs: BufferSetLayout,
+    /// Vertices per patch edge.
     pub grid_size: u32,
+    /// The tiled kernel's workgroup shape and tile size.
     pub tuning: KernelTuning,
 }
 
 impl RiverKernel {
+    /// Both pipelines for patches of `grid_size` vertices a side, the tiled one with `tuning` (checked against the
+    /// device's limits).
     pub fn new(
         ctx: &Context,
         bindless: &Bindless,

@@ -37,9 +37,11 @@ pub struct VertexCapture {
 /// One vertex of a drawn quadrant in a [`VertexCapture`].
 #[derive(Clone, Copy, Debug)]
 pub struct DrawnVertex {
+    /// The patch it belongs to.
     pub patch: PatchId,
     /// Its grid point in the patch.
     pub i: u32,
+    /// See `i`.
     pub j: u32,
     /// Position relative to the capture's camera.
     pub relative: DVec3,

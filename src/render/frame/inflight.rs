@@ -26,7 +26,9 @@ pub(super) struct InFlight {
 /// The GPU time per pass of one finished frame.
 #[derive(Clone, Debug)]
 pub struct GpuTimes {
+    /// The frame's number.
     pub frame: u64,
+    /// Milliseconds per pass.
     pub ms: BTreeMap<String, f64>,
 }
 

@@ -136,10 +136,15 @@ pub struct Renderer<'w> {
     /// GPU milliseconds per new patch (base heights and river data), averaged over recent frames: what the
     /// generation budget divides by.
     generation_ms_per_patch: Option<f64>,
+    /// The kernel variant that computes new patches' river data.
     pub variant: KernelVariant,
+    /// How water is drawn: from the mesh where it carves, painted, or as geometry (Section 8.4).
     pub water_mode: WaterMode,
+    /// What the terrain shows: shading, the patches' levels, painted rivers in red.
     pub view_mode: ViewMode,
+    /// The terrain drawn as lines, without the water pass.
     pub wireframe_on: bool,
+    /// Keep drawing the patches selected when it was set (to look at a selection from elsewhere).
     pub freeze_lod: bool,
     /// Beyond the thesis: the atmosphere (scattering in the shell of `atmosphere-height`); `false`: a constant
     /// haze and the clear colour behind the planet, as before it.
@@ -172,10 +177,13 @@ pub struct Renderer<'w> {
     kernel_observer: Option<KernelObserver<'w>>,
     /// Record where the terrain pass put every vertex in `last_capture` (tests of precision and morphing).
     pub capture_vertices: bool,
+    /// The last frame's capture, where `capture_vertices` is set.
     pub last_capture: Option<VertexCapture>,
 }
 
 impl<'w> Renderer<'w> {
+    /// A renderer of `planet` and its rivers for targets of `color_format` and `depth_format`: its pipelines,
+    /// the bindless set and the patch cache sized to the configuration's budgets.
     pub fn new(
         ctx: &'w Context,
         planet: &'w Planet,

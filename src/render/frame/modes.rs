@@ -31,6 +31,7 @@ impl crate::named::Named for ViewMode {
 }
 
 impl WaterMode {
+    /// The mode after this one, in the viewer's cycle.
     pub fn next(self) -> Self {
         match self {
             WaterMode::Auto => WaterMode::Geometry,
@@ -44,6 +45,7 @@ impl WaterMode {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ViewMode {
+    /// The terrain and water as they look.
     Shaded,
     /// Patches tinted by level of detail.
     Lod,

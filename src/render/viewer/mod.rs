@@ -45,25 +45,44 @@ use crate::{
     world::World,
 };
 
+/// Why the viewer stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum ViewerError {
+    /// No window or event loop (no display).
     #[error("cannot open a window: {0} (no display? `riverplanet render` works without one)")]
     Window(String),
+    /// A Vulkan call failed.
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// A screenshot could not be written.
     #[error("cannot write screenshot {path}: {message}")]
-    Screenshot { path: String, message: String },
+    Screenshot {
+        /// The file.
+        path: String,
+        /// The reason.
+        message: String,
+    },
+    /// The recorded camera path could not be written.
     #[error("cannot write the camera path: {0}")]
     Path(String),
+    /// With validation on, the layer reported errors.
     #[error("the validation layer reported {count} error(s), the first: {first}")]
-    Validation { count: usize, first: String },
+    Validation {
+        /// How many.
+        count: usize,
+        /// The first one's message.
+        first: String,
+    },
 }
 
 /// Options of a viewer run.
 #[derive(Clone, Debug)]
 pub struct ViewerOptions {
+    /// The window's size, pixels.
     pub size: [u32; 2],
+    /// Where the camera starts, and what it looks at.
     pub eye: DVec3,
+    /// See `eye`.
     pub look_at: DVec3,
     /// Stop after this many frames (for tests under Xvfb).
     pub frames: Option<u64>,
@@ -77,8 +96,11 @@ pub struct ViewerOptions {
     pub overlay: bool,
     /// The configuration file given, for the sidecar's `render` command (`None`: the default).
     pub config: Option<PathBuf>,
+    /// The water mode at the start (M cycles it).
     pub water: super::WaterMode,
+    /// The atmosphere at the start (T toggles it).
     pub atmosphere: bool,
+    /// Flowing water (`false`: still water, as the thesis).
     pub flowing_water: bool,
     /// The water drawn by the terrain pass (`false`: the thesis's water pass).
     pub water_in_mesh: bool,
