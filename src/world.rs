@@ -21,7 +21,17 @@ pub struct World {
 impl World {
     /// Generates the planet (Chapter 4) and its river network (Chapter 5).
     pub fn build(config: &Config, seed: u32) -> Result<Self, PlanetError> {
-        let planet = Planet::generate(config, seed, |_| {})?;
+        Self::build_reporting(config, seed, |_| {})
+    }
+
+    /// As [`World::build`], telling `stage` what it does: the planet's stages, then `rivers`.
+    pub fn build_reporting(
+        config: &Config,
+        seed: u32,
+        mut stage: impl FnMut(&str),
+    ) -> Result<Self, PlanetError> {
+        let planet = Planet::generate(config, seed, &mut stage)?;
+        stage("rivers");
         let network = RiverNetwork::generate(&planet, config, seed);
         log::info!("world: seed {seed}, {} rivers", network.systems.len());
         Ok(Self {

@@ -26,7 +26,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             if let Some(path) = &json {
                 check_output("--json", path, false)?;
             }
-            let world = riverplanet::world::World::build(&config, planet.seed)?;
+            let world = super::progress::build_world(&config, planet.seed)?;
             let ctx = Context::new(options)?;
             let tuned = autotune::tuned(&ctx, config.rendering.vertices)?.tuning;
             let tuning = KernelTuning {
@@ -141,7 +141,7 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
                 draws: true,
                 ..options.clone()
             })?;
-            let world = riverplanet::world::World::build(&config, planet.seed)?;
+            let world = super::progress::build_world(&config, planet.seed)?;
             let progress = super::progress::Progress::start("flight");
             progress.count("flight", frames as u64);
             let options = bench::flight::FlightOptions {

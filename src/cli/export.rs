@@ -14,7 +14,10 @@ use riverplanet::{
     world::World,
 };
 
-use super::{progress::Progress, ExportCommand, RegionFormat};
+use super::{
+    progress::{build_world, Progress},
+    ExportCommand, RegionFormat,
+};
 use crate::{load_config, planet_seed, usage};
 
 /// The finest level `export rivers` refines the thesis's river pieces to (as `hull-levels`' range).
@@ -142,8 +145,8 @@ fn export_region(
     }
     let (config, _) = load_config(planet.config.as_deref())?;
     let seed = planet_seed(planet.seed, &config);
-    let progress = Progress::start("building the planet");
-    let world = World::build(&config, seed)?;
+    let world = build_world(&config, seed)?;
+    let progress = Progress::start("sampling the region");
     let surface = sample_region(
         &world.planet,
         &world.network,
@@ -189,7 +192,7 @@ fn carved_world(
     level: u32,
     progress: &Progress,
 ) -> anyhow::Result<(World, riverplanet::planet::heights::FaceLattice)> {
-    let world = World::build(config, seed)?;
+    let world = World::build_reporting(config, seed, |stage| progress.stage(stage.to_string()))?;
     let message = format!("carving the patches of level {level}");
     let lattice = carved_terrain(
         &world.planet,
@@ -261,7 +264,7 @@ fn export_rivers(planet: super::PlanetArgs, level: Option<u32>, out: &Path) -> a
         )));
     }
     let seed = planet_seed(planet.seed, &config);
-    let world = World::build(&config, seed)?;
+    let world = build_world(&config, seed)?;
     let geojson = if drainage {
         let level = level.unwrap_or(world.planet.stats.base_level);
         let network = finer::network_at(&world.planet, &config, level)

@@ -8,6 +8,17 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 pub struct Progress(Option<ProgressBar>);
 
+/// The planet and its rivers of `config` and `seed`, each stage shown on the terminal while it runs.
+pub fn build_world(
+    config: &riverplanet::config::Config,
+    seed: u32,
+) -> Result<riverplanet::world::World, riverplanet::planet::PlanetError> {
+    let progress = Progress::start("planet");
+    riverplanet::world::World::build_reporting(config, seed, |stage| {
+        progress.stage(stage.to_string())
+    })
+}
+
 impl Progress {
     /// A spinner showing `message` and the time since it started.
     pub fn start(message: impl Into<Cow<'static, str>>) -> Self {

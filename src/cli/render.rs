@@ -49,7 +49,7 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
         ..options.clone()
     })?;
     let seed = planet_seed(args.planet.seed, &config);
-    let world = riverplanet::world::World::build(&config, seed)?;
+    let world = super::progress::build_world(&config, seed)?;
     let (eye, look_at) = match (args.preset, &recorded) {
         (Some(preset), _) => {
             riverplanet::render::presets::camera(preset, &world).ok_or_else(|| {
@@ -120,8 +120,10 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     }
     let c = args.clear_color;
     let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
+    let progress = super::progress::Progress::start("rendering until every visible patch has its data");
     let (stats, frames) =
         renderer.render_until_streamed(&camera, &target.target(clear), args.max_frames)?;
+    drop(progress);
     let image = target.read(&ctx)?;
     riverplanet::export::files::save_image(&image, &args.out)?;
     println!(
@@ -223,7 +225,7 @@ pub fn view(options: &ContextOptions, args: &ViewArgs) -> anyhow::Result<()> {
     riverplanet::gpu::adapter::check_can_draw(options)?;
     let event_loop = riverplanet::render::viewer::event_loop()?;
     let seed = planet_seed(args.planet.seed, &config);
-    let world = riverplanet::world::World::build(&config, seed)?;
+    let world = super::progress::build_world(&config, seed)?;
     let (eye, look_at) = match args.eye {
         Some(eye) => (eye, args.look_at),
         None => riverplanet::render::presets::camera(
