@@ -120,7 +120,8 @@ pub fn render(options: &ContextOptions, args: &RenderArgs) -> anyhow::Result<()>
     }
     let c = args.clear_color;
     let clear = [c.x as f32, c.y as f32, c.z as f32, 1.0];
-    let progress = super::progress::Progress::start("rendering until every visible patch has its data");
+    let progress =
+        super::progress::Progress::start("rendering until every visible patch has its data");
     let (stats, frames) =
         renderer.render_until_streamed(&camera, &target.target(clear), args.max_frames)?;
     drop(progress);

@@ -385,6 +385,37 @@ mod tests {
         }
     }
 
+    /// A hostile probe: libtiff's LZW files with bytes changed at random (in the directory, the offsets, the codes)
+    /// are read or refused, never a panic or an allocation of what they claim.
+    #[test]
+    fn damaged_lzw_tiffs_are_refused_or_read_never_a_panic() {
+        let mut rng = crate::rng::Rng::new(35, &[39]);
+        let path = std::env::temp_dir().join(format!(
+            "riverplanet-damaged-lzw-{}.tif",
+            std::process::id()
+        ));
+        let (mut refused, mut read) = (0, 0);
+        for name in ["lzw-float32-predictor3.tif", "lzw-int32-predictor2.tif"] {
+            let original = std::fs::read(data(name)).unwrap();
+            for _ in 0..300 {
+                let mut file = original.clone();
+                for _ in 0..1 + rng.below(4) {
+                    let at = rng.below(file.len() as u64) as usize;
+                    file[at] = rng.next_u64() as u8;
+                }
+                std::fs::write(&path, &file).unwrap();
+                match read_tiff(&path) {
+                    Ok(_) => read += 1,
+                    Err(_) => refused += 1,
+                }
+            }
+        }
+        std::fs::remove_file(&path).unwrap();
+        println!("{refused} damaged files refused, {read} read");
+        // Most changes land in the compressed codes, which decode to other heights or are refused.
+        assert!(refused > 0 && read > 0, "{refused} refused, {read} read");
+    }
+
     /// A big-endian tiled TIFF (16 x 16 tiles over 40 x 20 pixels, the edge tiles padded), floating-point
     /// predictor: the tiles' layout and the byte order, which libtiff's strips above do not cover; and the same
     /// file made hostile.
