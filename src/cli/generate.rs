@@ -41,7 +41,9 @@ pub fn generate(
     let river_ms = t.elapsed().as_secs_f64() * 1e3;
     // The GeoJSON holds the branches stats.json counts.
     let geojson_depth = config.river.hull_levels;
+    let t = std::time::Instant::now();
     let (rivers, tributaries) = network.count(geojson_depth);
+    let count_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = std::time::Instant::now();
     progress.stage("writing");
     // Everything below replaces the folder's old set as a whole, or not at all.
@@ -84,6 +86,7 @@ pub fn generate(
     riverplanet::export::files::write_bytes(&path, serde_json::to_string(&geojson)?.as_bytes())?;
     let mut stats = planet.stats.clone();
     stats.timings_ms.insert("rivers".to_string(), river_ms);
+    stats.timings_ms.insert("river count".to_string(), count_ms);
     // The finer levels' streams are routed within the rivers' stage; each level's share apart.
     for level in &network.streams {
         stats

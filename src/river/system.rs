@@ -325,10 +325,17 @@ fn meander_knots(segment: &Segment, params: &SubdivisionParams) -> Option<Knots>
     if segment.lake || segment.depth < FIRST_MEANDER_DEPTH {
         return None;
     }
-    let valley = ValleyLine::new(&segment.curve);
-    let length = valley.length();
     let mut rng = Rng::new(params.seed, &[STREAM_MEANDER, segment.key]);
     let wavelength = meander_wavelength(segment) * rng.range_f64(0.85, 1.15);
+    // Too short for two half wavelengths even at the longest it can be (its control polygon's length) and the
+    // largest swing: decided without measuring the valley line, which most pieces are (the same answer as below).
+    let longest = segment.polygon_length() * (1.0 + 1e-9);
+    let widest_swing = meanders::swing_on(0.0) * 1.15;
+    if meanders::half_wavelengths(longest, wavelength, widest_swing) < 2.0 {
+        return None;
+    }
+    let valley = ValleyLine::new(&segment.curve);
+    let length = valley.length();
     let drop = (segment.heights.0 - segment.heights.1).max(0.0) as f64;
     let swing = meanders::swing_on(drop / length.max(f64::MIN_POSITIVE) / relief_slope)
         * rng.range_f64(0.85, 1.15);
@@ -379,7 +386,8 @@ struct ValleyLine {
 
 impl ValleyLine {
     fn new(curve: &Hermite) -> Self {
-        let mut lengths = vec![0.0];
+        let mut lengths = Vec::with_capacity(VALLEY_SAMPLES + 1);
+        lengths.push(0.0);
         let mut previous = curve.point(0.0);
         for k in 1..=VALLEY_SAMPLES {
             let p = curve.point(k as f64 / VALLEY_SAMPLES as f64);
