@@ -224,8 +224,9 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
     }
     // Beyond the thesis: a vertex a lake reaches, outside every river's basin, gets the lake's level as its
     // water, a distance of 0 and the lake half width, which the shaders read as a basin whose water the mesh shows
-    // where the terrain lies below it; in a river's basin, an inflow's water above the level comes down to it
-    // across the lake's reach, its bed with it (src/kernel/cpu.rs, with_lake).
+    // where the terrain lies below it, and its rivers' terrain above the level brought down to it as an inflow's
+    // water is; in a river's basin, an inflow's water above the level comes down to it across the lake's reach,
+    // its bed with it (src/kernel/cpu.rs, with_lake).
     if (acc.lakeLevel > -3.402823466e38) {
         if (acc.inRiver) {
             float excess = heights.z - acc.lakeLevel;
@@ -235,6 +236,11 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
                 heights.x -= drop;
             }
         } else {
+            float excess = heights.x - acc.lakeLevel;
+            if (excess > 0.0) {
+                precise float drop = excess * (1.0 - acc.lakeOffset2);
+                heights.x -= drop;
+            }
             heights.z = acc.lakeLevel;
             heights.w = 0.0;
             riverWidth = LAKE_HALF_WIDTH;

@@ -233,9 +233,12 @@ pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelPar
 /// distance of 0 and a half width of [`LAKE_HALF_WIDTH`], which the shaders
 /// read as "in a basin whose water the mesh shows": the water is drawn where the terrain lies below the level, so
 /// the shore is the terrain's contour. The lerp factor stays as the rivers make it, so the terrain is the
-/// planet's own. A river's basin keeps its river's water (an outlet's falls below the level), except that an
-/// inflow's water standing above the level comes down to it across the lake's reach, its bed with it: by the
-/// excess times 1 - `lake_offset2`, so it meets the level on the lake's line and is unchanged at the reach's edge.
+/// planet's own; but the rivers' terrain there (an inflow's valley floor, which the lerp factor blends in beside it)
+/// comes down to the level as an inflow's water does, so the drawn ground does not stand above the lake's water at
+/// its points (tests/river_surface.rs) and the valley beyond is as it was.
+/// A river's basin keeps its river's water (an outlet's falls below the level), except that an inflow's water
+/// standing above the level comes down to it across the lake's reach, its bed with it: by the excess times 1 -
+/// `lake_offset2`, so it meets the level on the lake's line and is unchanged at the reach's edge.
 fn with_lake(mut texel: RiverTexel, acc: &Accumulators) -> RiverTexel {
     if acc.lake_level == -f32::MAX {
         return texel;
@@ -248,6 +251,10 @@ fn with_lake(mut texel: RiverTexel, acc: &Accumulators) -> RiverTexel {
             texel.terrain_height -= drop;
         }
     } else {
+        let excess = texel.terrain_height - acc.lake_level;
+        if excess > 0.0 {
+            texel.terrain_height -= excess * (1.0 - acc.lake_offset2);
+        }
         texel.water_height = acc.lake_level;
         texel.min_distance = 0.0;
         texel.river_width = LAKE_HALF_WIDTH;
