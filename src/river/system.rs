@@ -33,6 +33,9 @@ const KNOTS_PER_WAVELENGTH: f64 = 6.0;
 /// join it, whose lattice paths converge on the confluence (the default planet's river view showed loops of a
 /// main stem and its tributary overlapping); from this depth on, belts stay within a few hundredths of a cell.
 const FIRST_MEANDER_DEPTH: u32 = 2;
+/// A meandering piece's wavelength and swing vary by this factor from piece to piece (up to 15 % either way), as
+/// real meanders are not a regular wave.
+const PIECE_VARIATION: (f64, f64) = (0.85, 1.15);
 /// Points along a piece's valley line for its arc length.
 const VALLEY_SAMPLES: usize = 64;
 /// Tributaries of tributaries at most.
@@ -326,11 +329,12 @@ fn meander_knots(segment: &Segment, params: &SubdivisionParams) -> Option<Knots>
         return None;
     }
     let mut rng = Rng::new(params.seed, &[STREAM_MEANDER, segment.key]);
-    let wavelength = meander_wavelength(segment) * rng.range_f64(0.85, 1.15);
+    let wavelength =
+        meander_wavelength(segment) * rng.range_f64(PIECE_VARIATION.0, PIECE_VARIATION.1);
     // Too short for two half wavelengths even at the longest it can be (its control polygon's length) and the
     // largest swing: decided without measuring the valley line, which most pieces are (the same answer as below).
     let longest = segment.polygon_length() * (1.0 + 1e-9);
-    let widest_swing = meanders::swing_on(0.0) * 1.15;
+    let widest_swing = meanders::swing_on(0.0) * PIECE_VARIATION.1;
     if meanders::half_wavelengths(longest, wavelength, widest_swing) < 2.0 {
         return None;
     }
@@ -338,7 +342,7 @@ fn meander_knots(segment: &Segment, params: &SubdivisionParams) -> Option<Knots>
     let length = valley.length();
     let drop = (segment.heights.0 - segment.heights.1).max(0.0) as f64;
     let swing = meanders::swing_on(drop / length.max(f64::MIN_POSITIVE) / relief_slope)
-        * rng.range_f64(0.85, 1.15);
+        * rng.range_f64(PIECE_VARIATION.0, PIECE_VARIATION.1);
     let halves = meanders::half_wavelengths(length, wavelength, swing);
     if swing < meanders::MIN_SWING || !(2.0..=MOST_MEANDER_HALVES).contains(&halves) {
         return None;
