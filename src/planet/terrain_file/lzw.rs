@@ -188,12 +188,12 @@ pub(super) const LZW: u16 = 5;
 /// The most bytes an LZW TIFF may decode to: the tiff crate's default limit for the other compressions.
 const DECODED_LIMIT: usize = 256 << 20;
 
-/// An LZW-compressed TIFF's heights, strip by strip or tile by tile: one channel of the sample types
-/// `read_tiff` takes, in chunky order.
+/// An LZW-compressed TIFF's width, height and heights, strip by strip or tile by tile: one channel of the sample
+/// types `read_tiff` takes, in chunky order.
 pub(super) fn read_image<R: std::io::Read + std::io::Seek>(
     decoder: &mut tiff::decoder::Decoder<R>,
     (width, height): (u32, u32),
-) -> Result<super::read::Heights, String> {
+) -> Result<(u32, u32, Vec<f32>), String> {
     use tiff::tags::Tag;
     let mut unsigned = |tag: Tag| -> Result<Option<Vec<u64>>, String> {
         decoder
