@@ -26,11 +26,11 @@ layout(constant_id = 4) const uint SUBGROUP_SIZE = 8;
 #include "river_kernel.glsl"
 #include "kernel_blocks.glsl"
 
-// The staged samples, prepared (prepareSample), as arrays of vec4, vec2 and float: 28 bytes a sample, faster
-// than an array of structs on lavapipe, and 1024 of them fit 32 KiB of shared memory.
+// The staged samples, prepared (prepareSample), as arrays of vec4, vec2 and vec2: 32 bytes a sample, faster
+// than an array of structs on lavapipe; 992 of them fit 32 KiB of shared memory with the counts.
 shared vec4 tilePositionDerivative[TILE_SIZE];
 shared vec2 tileHeightHalfWidth[TILE_SIZE];
-shared float tileReach[TILE_SIZE];
+shared vec2 tileReachRiver[TILE_SIZE];
 // In-reach samples of a chunk counted by each subgroup (at most one subgroup per invocation), in two rows.
 const uint MAX_SUBGROUPS = BLOCK_X * BLOCK_Y;
 const uint TILE_WORDS = TILE_SIZE / 32;
@@ -60,13 +60,13 @@ void accumulateTile(inout Accumulators acc, vec2 v, uint staged) {
         uint mine = min(first + gl_SubgroupInvocationID, staged - 1);
         vec4 positionDerivative = tilePositionDerivative[mine];
         vec2 heightHalfWidth = tileHeightHalfWidth[mine];
-        float reach = tileReach[mine];
+        vec2 reachRiver = tileReachRiver[mine];
         uint sharing = min(SUBGROUP_SIZE, staged - first);
         for (uint from = 0; from < SUBGROUP_SIZE; ++from) {
             if (from >= sharing) break;
             PreparedSample s = PreparedSample(subgroupBroadcast(positionDerivative, from),
                 subgroupBroadcast(heightHalfWidth.x, from), subgroupBroadcast(heightHalfWidth.y, from),
-                subgroupBroadcast(reach, from));
+                subgroupBroadcast(reachRiver.x, from), subgroupBroadcast(reachRiver.y, from));
             accumulateSample(acc, v, s);
         }
     }
@@ -125,7 +125,7 @@ void main() {
             PreparedSample s = prepareSample(samples[job.sampleOffset + k]);
             tilePositionDerivative[at] = s.positionDerivative;
             tileHeightHalfWidth[at] = vec2(s.height, s.halfWidth);
-            tileReach[at] = s.reach;
+            tileReachRiver[at] = vec2(s.reach, s.river);
             ++at;
         }
         filled += found;

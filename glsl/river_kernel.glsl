@@ -3,7 +3,7 @@
 #extension GL_EXT_nonuniform_qualifier : require
 
 // Position (xy) and first derivative (zw); height (x), full width (y) and, beyond the thesis, the sample's own
-// influence distance (z; 0: the kernel's, which bounds it).
+// influence distance (z; 0: the kernel's, which bounds it) and its river's number (w).
 struct RiverSample {
     vec4 positionDerivative;
     vec4 heightWidth;
@@ -32,7 +32,9 @@ const uint NO_PARENT = 0xffffffffu;
 // The half width a lake's vertices report (LAKE_HALF_WIDTH in src/kernel/cpu.rs).
 const float LAKE_HALF_WIDTH = 1e9;
 
-// Layer 0: terrain height, lerp factor, water height, signed minimum distance. Layer 1: river half width.
+// Layer 0: terrain height, lerp factor, water height, signed minimum distance. Layer 1: river half width, flow.
+// Layer 2 (beyond the thesis): the second river's signed distance and half width, the nearest sample's half
+// width, the rivers' order (src/kernel/mod.rs, RiverTexel).
 // Read as well as written: rows that copy from the parent read its texture.
 layout(set = 0, binding = 0, rgba32f) uniform image2DArray riverImages[];
 layout(set = 1, binding = 0, std430) readonly buffer Samples { RiverSample samples[]; };
@@ -71,7 +73,7 @@ uvec2 patchVertex(PatchJob job, uvec2 xy) {
 void copyFromParent(PatchJob job, uvec2 xy) {
     ivec2 from = ivec2(xy + uvec2(job.parentOffset & 0xffffu, job.parentOffset >> 16));
     ivec2 to = ivec2(patchVertex(job, xy));
-    for (int layer = 0; layer < 2; ++layer) {
+    for (int layer = 0; layer < 3; ++layer) {
         imageStore(riverImages[job.slot], ivec3(to, layer), imageLoad(riverImages[job.parentSlot], ivec3(from, layer)));
     }
 }
@@ -92,6 +94,13 @@ struct Accumulators {
     float nearestReach;
     // The half width of the nearest sample.
     float nearestHalfWidth;
+    // Beyond the thesis: the nearest sample's river number (-1 before any), and the nearest sample of another
+    // river: its signed distance, the square of it, its half width and river number.
+    float nearestRiver;
+    float secondDistance;
+    float secondDistance2;
+    float secondHalfWidth;
+    float secondRiver;
     // Beyond the thesis: the highest level of the lakes whose samples reach the vertex (-FLT_MAX: none).
     float lakeLevel;
     // Beyond the thesis: how far into that lake's reach the vertex lies from the lake's nearest sample, as the
@@ -104,7 +113,8 @@ struct Accumulators {
 
 Accumulators initAccumulators() {
     return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38,
-                        params.influenceDistance, 0.0, -3.402823466e38, 1.0, vec2(0.0));
+                        params.influenceDistance, 0.0, -1.0, 3.402823466e38, 3.402823466e38, 0.0, -1.0,
+                        -3.402823466e38, 1.0, vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -115,11 +125,13 @@ struct PreparedSample {
     float halfWidth;
     // The sample's influence distance.
     float reach;
+    // Its river's number.
+    float river;
 };
 
 PreparedSample prepareSample(RiverSample s) {
     float reach = s.heightWidth.z > 0.0 ? s.heightWidth.z : params.influenceDistance;
-    return PreparedSample(s.positionDerivative, s.heightWidth.x, s.heightWidth.y * 0.5, reach);
+    return PreparedSample(s.positionDerivative, s.heightWidth.x, s.heightWidth.y * 0.5, reach, s.heightWidth.w);
 }
 
 // Procedure 3 for one sample, accumulated as in Procedure 4: the CPU reference's quantities
@@ -189,11 +201,25 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
             // d / |d| without another square root: inverseScale x halfWidth = 1 / |d| (and d = 0 stays 0).
             acc.flowSum += wRiver * (d * (inverseScale * s.halfWidth));
         }
+        // Beyond the thesis: the nearest sample, and the nearest of another river.
+        float signedDist = side > 0.0 ? -dist : dist;
         if (dist2 < acc.minDistance2) {
+            if (s.river != acc.nearestRiver) {
+                acc.secondDistance = acc.minDistance;
+                acc.secondDistance2 = acc.minDistance2;
+                acc.secondHalfWidth = acc.nearestHalfWidth;
+                acc.secondRiver = acc.nearestRiver;
+            }
             acc.minDistance2 = dist2;
-            acc.minDistance = side > 0.0 ? -dist : dist;
+            acc.minDistance = signedDist;
             acc.nearestReach = reach;
             acc.nearestHalfWidth = s.halfWidth;
+            acc.nearestRiver = s.river;
+        } else if (s.river != acc.nearestRiver && dist2 < acc.secondDistance2) {
+            acc.secondDistance = signedDist;
+            acc.secondDistance2 = dist2;
+            acc.secondHalfWidth = s.halfWidth;
+            acc.secondRiver = s.river;
         }
     }
 }
@@ -203,7 +229,13 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
     vec4 heights = vec4(0.0, 1.0, params.seaLevel, params.influenceDistance);
     float riverWidth = 0.0;
     vec2 flow = vec2(0.0);
+    // Beyond the thesis: the second river's signed distance and half width, the nearest sample's half width and
+    // the rivers' order (1: the nearest's number below the second's, -1 above, 0 no second).
+    vec4 second = vec4(params.influenceDistance, 0.0, 0.0, 0.0);
     if (acc.weightSum > 0.0) {
+        bool other = acc.secondRiver >= 0.0;
+        second = vec4(other ? acc.secondDistance : params.influenceDistance, acc.secondHalfWidth,
+                      acc.nearestHalfWidth, other ? (acc.nearestRiver < acc.secondRiver ? 1.0 : -1.0) : 0.0);
         float height = acc.heightSum / acc.weightSum;
         float basin = acc.basinSum / acc.weightSum;
         // Beyond the thesis: a vertex nearest to a sample with its own, shorter reach (a finer level's stream) has
@@ -244,8 +276,10 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
             heights.z = acc.lakeLevel;
             heights.w = 0.0;
             riverWidth = LAKE_HALF_WIDTH;
+            second.zw = vec2(0.0);
         }
     }
     imageStore(riverImages[job.slot], ivec3(xy, 0), heights);
     imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, flow, 0.0));
+    imageStore(riverImages[job.slot], ivec3(xy, 2), second);
 }

@@ -247,6 +247,30 @@ const float RIVER_JOIN_SPACING = 8.0;
 // river's.
 const float WIDTH_SLOPE_LIMIT = 0.25;
 
+// Beyond the thesis: RIVER_SLOPE_FLOOR for the river pair. Across a straight river the interpolated distance
+// changes by one unit per unit of length; where a triangle's vertices lie on either side of the line a river's
+// end points along (beyond a tributary's mouth or a source, the distance to the end's sample changes sign there)
+// the interpolant is flatter and paints a false stripe across the triangle. The second river is measured at many
+// more vertices than the nearest, mostly beside ends: with the nearest's floor, 0.5, such stripes joined rivers
+// from orbit into painted 5x5 squares (3 on the diffused world of docs/planet.md); with 0.8, none were added.
+const float PAIR_SLOPE_FLOOR = 0.8;
+
+// Beyond the thesis (docs/rendering.md, "Painted confluences"): the share of the pixel in the band |d| < w of
+// one slot of the river pair, where the triangle's vertices measured one river in it (the distance's and the
+// width's slopes as for the nearest river, above) and `mode` paints it (a river at least as wide as the vertex
+// spacing is the mesh's in `auto`); -1 where not. `dd`, `dw`: the slot's screen derivatives.
+float pairBand(float d, float w, vec2 dd, vec2 dw, vec3 px, vec3 py, uint mode) {
+    bool painted = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= w);
+    float slope = distanceSlope(dd, px, py);
+    bool flatDistance = slope < PAIR_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * w;
+    if (!painted || w <= 0.0 || slope > RIVER_SLOPE_LIMIT || flatDistance
+        || distanceSlope(dw, px, py) > WIDTH_SLOPE_LIMIT) {
+        return -1.0;
+    }
+    float e = abs(dd.x) + abs(dd.y) + 1e-4;
+    return 1.0 - smoothBand(w - e, w + e, abs(d));
+}
+
 // Beyond the thesis (docs/rendering.md, "Lakes from afar"): the cube faces' axes (normal, u, v; planet/cube.rs
 // FACE_AXES), the lake map's layers.
 const vec3 FACE_NORMAL[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1),
@@ -297,6 +321,8 @@ void main() {
     float footprint = sqrt(max(dot(px, px), dot(py, py)));
     vec2 dw = vec2(dFdx(fRiver.w), dFdy(fRiver.w));
     float joinEdge = fwidth(fBank) + 1e-4;
+    vec4 pairX = dFdx(fRiverPair);
+    vec4 pairY = dFdy(fRiverPair);
     float zSlope = distanceSlope(dz, px, py);
     bool flatDistance = zSlope < RIVER_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * fRiver.w;
     bool measured = zSlope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw, px, py) <= WIDTH_SLOPE_LIMIT;
@@ -313,7 +339,8 @@ void main() {
     // Section 8.4: paint a river the mesh is too coarse to carve (vertices not closer than half its width, the
     // thesis's rule, in `auto`), from the signed distance and width; as water half a colour band deep. Where the
     // distance was measured to different rivers (beyond the thesis, distanceSlope), at a confluence, the signed
-    // distances do not interpolate; the distances to the banks do (the union of the rivers' water, each vertex
+    // distances do not interpolate; the two nearest rivers in their order do where the vertices agree on them
+    // (the union of both bands), else the distances to the banks (the union of the rivers' water, each vertex
     // measuring the nearest): water where they interpolate below 0 (docs/rendering.md, "Painted confluences").
     uint mode = waterMode();
     bool paint = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= fRiver.w);
@@ -322,7 +349,11 @@ void main() {
     // line the river ends on, and from afar a large triangle with one would be painted whole.
     bool joinable = fSpacing <= RIVER_JOIN_SPACING * fRiver.w;
     float joined = joinable ? 1.0 - smoothBand(-joinEdge, joinEdge, fBank) : 0.0;
-    float painted = paint ? (measured ? inBasin : joined) : 0.0;
+    float lowRiver = pairBand(fRiverPair.x, fRiverPair.y, vec2(pairX.x, pairY.x), vec2(pairX.y, pairY.y), px, py, mode);
+    float highRiver = pairBand(fRiverPair.z, fRiverPair.w, vec2(pairX.z, pairY.z), vec2(pairX.w, pairY.w), px, py, mode);
+    bool pairMeasured = lowRiver >= 0.0 && highRiver >= 0.0;
+    float nearest = paint ? (measured ? inBasin : pairMeasured ? 0.0 : joined) : 0.0;
+    float painted = max(nearest, max(max(lowRiver, highRiver), 0.0));
     // Beyond the thesis (docs/rendering.md, "Water in the terrain mesh"): the sea and the rivers the mesh shows,
     // over the terrain's colour as the water pass blends them: where the terrain lies below the water's surface
     // (what the water pass's depth test decides) and, for a river, within its width (where the water pass cuts

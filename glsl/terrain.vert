@@ -28,6 +28,7 @@ void main() {
     // reaching it paints no river between its vertices (terrain.frag, distanceSlope).
     if (v.surface.w == 0.0) s.river.z = FAR_FROM_RIVERS;
     s.inBasin = inRiverBasin(v.surface);
+    s.pair = v.pair;
     // How far the vertex lies from the banks of the river it measured (negative inside; with no river, the
     // influence distance: at least that far from any), for painting where a triangle's vertices measured different
     // rivers (terrain.frag). A lake's vertex counts as one spacing outside: lakes are drawn from their own data.

@@ -54,6 +54,8 @@ struct PatchInstance {
 // Beyond the thesis: a vertex a lake reaches reports a half width of 1e9 (docs/kernel.md, "Lakes"), so a triangle
 // with one has an interpolated half width far above any river's.
 const float LAKE_HALF_WIDTH_FLOOR = 1e6;
+// The signed distance of a point no river reaches.
+const float FAR_FROM_RIVERS = 1e9;
 
 // Whether a vertex of `surface` (terrain height, water height, signed distance, half width) lies in a river's
 // basin: |signed distance| < half width (Section 8.4; false where no river reaches, half width 0).

@@ -1,4 +1,4 @@
-// What terrain.frag reads, written by terrain.vert (terrain pass) and terrain.geom (water pass), packed into eight
+// What terrain.frag reads, written by terrain.vert (terrain pass) and terrain.geom (water pass), packed into nine
 // vec4 slots: lavapipe's draw module and triangle setup work per slot, per vertex and per triangle, on one thread
 // (docs/rendering.md, "The patch mesh and the shaders"). Writers define TERRAIN_WRITER before including it.
 
@@ -19,6 +19,9 @@ layout(location = 6) TERRAIN_IO vec4 ioTransmittanceSunB; // the air's transmitt
 // measured (`bank`). The level, the vertex spacing: the same at a triangle's three vertices (so interpolated, not
 // flat, to share the slot); whether the vertex lies in a river basin (1) or not (0).
 layout(location = 7) TERRAIN_IO vec4 ioKindLevelSpacingBasin;
+// Beyond the thesis: the two nearest rivers in their order, signed distance and half width each (riverPairAt in
+// terrain_vertex.glsl); the terrain pass paints their union where a triangle's vertices agree on them.
+layout(location = 8) TERRAIN_IO vec4 ioRiverPair;
 
 // One vertex of what terrain.frag reads.
 struct SurfaceVertex {
@@ -33,6 +36,7 @@ struct SurfaceVertex {
     vec3 transmittance;   // what the air between the eye and the vertex lets through
     bool riverWater;      // the water pass only
     float bank;           // the terrain pass only: |signed distance| - half width (negative in the river)
+    vec4 pair;            // the terrain pass only: the two nearest rivers in their order
     float level;
     float spacing;
     bool inBasin;         // |signed distance| < half width
@@ -48,6 +52,7 @@ void writeSurface(SurfaceVertex v) {
     ioInscatterSunG = vec4(v.inscatter, v.sunlight.g);
     ioTransmittanceSunB = vec4(v.transmittance, v.sunlight.b);
     ioKindLevelSpacingBasin = vec4(v.riverWater ? 1.0 : v.bank, v.level, v.spacing, v.inBasin ? 1.0 : 0.0);
+    ioRiverPair = v.pair;
 }
 #else
 #define fPosition ioPositionFlowX.xyz
@@ -65,4 +70,5 @@ void writeSurface(SurfaceVertex v) {
 #define fSpacing ioKindLevelSpacingBasin.z
 // Above 0 where any vertex of the triangle lies in a river basin (the water pass's choice of river triangles).
 #define fNearBasin ioKindLevelSpacingBasin.w
+#define fRiverPair ioRiverPair
 #endif

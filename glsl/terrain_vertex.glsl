@@ -57,18 +57,38 @@ float heightAt(PatchInstance p, vec2 grid, float morph) {
     return mix(river.x, base, river.y);
 }
 
-// The signed distance of a point no river reaches.
-const float FAR_FROM_RIVERS = 1e9;
+// A river pair's slot without a river (see riverPairAt).
+const vec2 NO_RIVER = vec2(FAR_FROM_RIVERS, 0.0);
+
+// Beyond the thesis (docs/rendering.md, "Painted confluences"): the two nearest rivers at a grid position, signed
+// distance and half width each, in the rivers' order (the lower number first), so that the vertices of a triangle
+// between two rivers agree on which slot holds which; a slot no river fills is NO_RIVER. From layer 2 of the river
+// data (the second river, the nearest sample's half width, the order) and the nearest distance, blended as
+// riverAt blends.
+vec4 riverPairAt(PatchInstance p, vec2 grid, float morph, float nearestDistance) {
+    float n = frame.planet.y;
+    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, 2.0);
+    vec4 second = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
+    if (morph > 0.0 && p.slots.w >= 0) {
+        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, 2.0);
+        second = mix(second, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
+    }
+    vec2 nearest = second.z > 0.0 ? vec2(nearestDistance, second.z) : NO_RIVER;
+    vec2 other = second.y > 0.0 && second.w != 0.0 ? second.xy : NO_RIVER;
+    return second.w < 0.0 ? vec4(other, nearest) : vec4(nearest, other);
+}
 
 // Terrain height, water height, signed distance and half width at a grid position, from the patch's (or its
-// stand-in's) textures; `flow`: the water's flow in the patch frame.
-vec4 surfaceAt(PatchInstance p, vec2 grid, float morph, out vec2 flow) {
+// stand-in's) textures; `flow`: the water's flow in the patch frame; `pair`: riverPairAt.
+vec4 surfaceAt(PatchInstance p, vec2 grid, float morph, out vec2 flow, out vec4 pair) {
     float base = baseAt(p, grid);
     flow = vec2(0.0);
+    pair = vec4(NO_RIVER, NO_RIVER);
     if (p.slots.y < 0) return vec4(base, frame.sun.w, FAR_FROM_RIVERS, 0.0);
     vec3 widthFlow;
     vec4 river = riverAt(p, grid, morph, widthFlow);
     flow = widthFlow.yz;
+    pair = riverPairAt(p, grid, morph, river.w);
     // Section 8.2: blend the river terrain into the base terrain by the lerp factor.
     float height = mix(river.x, base, river.y);
     return vec4(height, max(river.z, frame.sun.w), river.w, widthFlow.x);
@@ -110,6 +130,7 @@ struct TerrainVertex {
     vec3 local;      // position - centreRel: small, the ground detail's coordinates build on it
     vec3 direction;  // unit direction from the planet centre
     vec4 surface;    // final height, water height, signed distance, river half width
+    vec4 pair;       // the two nearest rivers in their order (riverPairAt)
     vec3 flow;       // the water's flow: a world tangent, unit length where the samples agree
     vec2 grid;       // (i, j) within the patch, unmorphed
     vec2 morphed;    // the grid position morphed towards the parent's mesh
@@ -177,7 +198,7 @@ TerrainVertex terrainVertex(PatchInstance p, int id) {
     v.morph = morphFactor(p, v.grid, length(positionAt(p, baseAt(p, v.grid), directionOffset(p, v.grid))));
     v.morphed = morphedGrid(v.grid, v.morph);
     vec2 flow;
-    v.surface = surfaceAt(p, v.morphed, v.morph, flow);
+    v.surface = surfaceAt(p, v.morphed, v.morph, flow, v.pair);
     v.offset = directionOffset(p, v.morphed);
     place(p, v);
     v.flow = flowTangent(p, flow, v.direction);
@@ -231,8 +252,11 @@ struct CachedVertex {
     vec4 normalMorph;  // the normal; the morph factor
     vec4 surface;      // height (of the grid point), water height, signed distance, half width
     uvec4 shading;     // flow.xy, flow.z and sunlight.r, sunlight.gb, inscatter.rg
-    uvec4 air;         // inscatter.b and transmittance.r, transmittance.gb; zw unused (std430 pads to 16 bytes)
+    uvec4 air;         // inscatter.b and transmittance.r, transmittance.gb; the river pair (distances within f16)
 };
+
+// The largest distance the cache's f16 river pair holds (FAR_FROM_RIVERS comes back as this).
+const float PAIR_LIMIT = 60000.0;
 
 #ifdef VERTEX_CACHE_WRITER
 layout(set = 1, binding = 2, std430) writeonly buffer VertexCache { CachedVertex cachedVertices[]; };
@@ -250,7 +274,9 @@ void storeVertex(uint index, TerrainVertex v, VertexShading s) {
     c.surface = v.surface;
     c.shading = uvec4(packHalf2x16(v.flow.xy), packHalf2x16(vec2(v.flow.z, s.sunlight.r)), packHalf2x16(s.sunlight.gb),
                       packHalf2x16(s.inscatter.rg));
-    c.air = uvec4(packHalf2x16(vec2(s.inscatter.b, s.transmittance.r)), packHalf2x16(s.transmittance.gb), 0u, 0u);
+    vec4 pair = clamp(v.pair, -PAIR_LIMIT, PAIR_LIMIT);
+    c.air = uvec4(packHalf2x16(vec2(s.inscatter.b, s.transmittance.r)), packHalf2x16(s.transmittance.gb),
+                  packHalf2x16(pair.xy), packHalf2x16(pair.zw));
     cachedVertices[index] = c;
 }
 #else
@@ -263,6 +289,7 @@ void loadVertex(PatchInstance p, int id, out TerrainVertex v, out VertexShading 
     v.morphed = morphedGrid(v.grid, v.morph);
     v.offset = directionOffset(p, v.morphed);
     v.surface = c.surface;
+    v.pair = vec4(unpackHalf2x16(c.air.z), unpackHalf2x16(c.air.w));
     place(p, v);
     vec2 flowZSunR = unpackHalf2x16(c.shading.y);
     vec2 inscatterBTransmittanceR = unpackHalf2x16(c.air.x);

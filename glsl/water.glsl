@@ -38,6 +38,7 @@ SurfaceVertex waterVertex(PatchInstance p, uint kind, vec3 local, vec4 surface, 
     s.detail = p.detail.xyz + lifted;
     s.riverWater = kind == WATER_RIVER;
     s.bank = 0.0;
+    s.pair = vec4(FAR_FROM_RIVERS, 0.0, FAR_FROM_RIVERS, 0.0);
     s.inBasin = false;
     s.level = p.centreRel.w;
     s.spacing = p.centreDir.w;

@@ -26,8 +26,10 @@ pub struct RiverSample {
     /// Beyond the thesis: the sample's own influence distance (0: the kernel's `influence-distance`, which bounds
     /// it). The streams of finer levels reach less far, so the thousands of them do not flatten the hills between.
     pub reach: f32,
-    /// Padding to two vec4s.
-    pub _pad: f32,
+    /// Beyond the thesis: which river the sample lies on, a whole number below 2^24 (exact in f32): a river runs
+    /// from its source to where it ends, a main stem keeping its number through the confluences where others join
+    /// it. The kernel keeps the nearest two rivers apart by it, for painted confluences (docs/rendering.md).
+    pub river: f32,
 }
 
 const _: () = assert!(size_of::<RiverSample>() == 32);
@@ -42,7 +44,7 @@ impl RiverSample {
             height,
             width,
             reach: 0.0,
-            _pad: 0.0,
+            river: 0.0,
         }
     }
 
@@ -50,6 +52,20 @@ impl RiverSample {
     pub fn with_reach(self, reach: f32) -> Self {
         Self { reach, ..self }
     }
+
+    /// The sample on the river whose key is `river` (see [`RiverSample::river`]).
+    pub fn on_river(self, river: u64) -> Self {
+        Self {
+            river: river_number(river),
+            ..self
+        }
+    }
+}
+
+/// The number a river's samples carry for its key: 24 bits of it, so that it is exact in f32 (two rivers near
+/// one vertex share one with a chance of 1 in 2^24).
+pub fn river_number(key: u64) -> f32 {
+    (key & 0xff_ffff) as f32
 }
 
 /// One row of the river kernel's range table (`PatchJob` in glsl/river_kernel.glsl): a patch, or for a patch

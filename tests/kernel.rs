@@ -207,9 +207,52 @@ fn no_relevant_sample_keeps_the_base_terrain() {
                 min_distance: p.influence_distance,
                 river_width: 0.0,
                 flow: [0.0; 2],
+                second_distance: p.influence_distance,
+                second_width: 0.0,
+                nearest_sample_width: 0.0,
+                river_order: 0.0,
             }
         );
     }
+}
+
+/// Beyond the thesis (docs/rendering.md, "Painted confluences"): between two rivers a vertex reports the nearest
+/// and the nearest sample of the other river, in the rivers' order; samples of the nearest river itself never
+/// count as the second, however many lie nearer than the other river.
+#[test]
+fn vertices_between_two_rivers_measure_both() {
+    let p = params();
+    // River 7 along y = 16 (width 4), river 3 along y = 22 (width 2), both flowing +x.
+    let main: Vec<RiverSample> = straight_river()
+        .into_iter()
+        .map(|s| s.on_river(7))
+        .collect();
+    let other: Vec<RiverSample> = (0..=192)
+        .map(|k| RiverSample::new([k as f32 / 6.0, 22.0], [1.0, 0.0], 5.0, 2.0).on_river(3))
+        .collect();
+    for samples in [
+        [main.clone(), other.clone()].concat(),
+        [other, main].concat(),
+    ] {
+        // Nearer the wide river: it is the nearest, the narrow one second (left of its flow: negative).
+        let t = cpu::calculate_height([10.0, 18.0], &samples, &p);
+        assert!((t.min_distance - -2.0).abs() < 1e-4, "{t:?}");
+        assert!((t.second_distance - 4.0).abs() < 1e-4, "{t:?}");
+        assert_eq!((t.nearest_sample_width, t.second_width), (2.0, 1.0));
+        assert_eq!(t.river_order, -1.0, "river 7 nearest, 3 second");
+        // Nearer the narrow one: the order turns.
+        let t = cpu::calculate_height([10.0, 21.0], &samples, &p);
+        assert!((t.min_distance - 1.0).abs() < 1e-4, "{t:?}");
+        assert!((t.second_distance - -5.0).abs() < 1e-4, "{t:?}");
+        assert_eq!(t.river_order, 1.0);
+    }
+    // One river alone: no second.
+    let t = cpu::calculate_height([10.0, 18.0], &straight_river(), &p);
+    assert_eq!(
+        (t.second_distance, t.second_width, t.river_order),
+        (p.influence_distance, 0.0, 0.0)
+    );
+    assert_eq!(t.nearest_sample_width, 2.0);
 }
 
 #[test]

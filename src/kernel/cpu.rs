@@ -147,6 +147,10 @@ pub struct Accumulators {
     pub nearest_reach: f32,
     /// The half width of the nearest sample.
     pub nearest_half_width: f32,
+    /// Beyond the thesis: the nearest sample's river number (-1 before any).
+    pub nearest_river: f32,
+    /// Beyond the thesis: the nearest sample of another river than the nearest sample's.
+    pub second: NearestSample,
     /// Beyond the thesis: the highest water level of the lake samples within half their width of the vertex
     /// (`-f32::MAX` where none is).
     pub lake_level: f32,
@@ -155,6 +159,28 @@ pub struct Accumulators {
     pub lake_offset2: f32,
     /// Beyond the thesis: sum of `w_river`-weighted downstream directions (the water's flow).
     pub flow_sum: [f32; 2],
+}
+
+/// The nearest sample of a river: its signed distance, the square of it, its half width and its river number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NearestSample {
+    /// The signed distance ([`SampleContribution::dist`]).
+    pub distance: f32,
+    /// Its square.
+    pub distance2: f32,
+    /// The sample's half width.
+    pub half_width: f32,
+    /// The sample's river number (-1: none yet).
+    pub river: f32,
+}
+
+impl NearestSample {
+    const NONE: Self = Self {
+        distance: f32::MAX,
+        distance2: f32::MAX,
+        half_width: 0.0,
+        river: -1.0,
+    };
 }
 
 /// Procedure 4, Section 6.5: accumulate the weighted contributions of every relevant sample.
@@ -175,6 +201,8 @@ pub fn accumulate_height(
         min_distance2: f32::MAX,
         nearest_reach: params.influence_distance,
         nearest_half_width: 0.0,
+        nearest_river: -1.0,
+        second: NearestSample::NONE,
         lake_level: -f32::MAX,
         lake_offset2: 1.0,
         flow_sum: [0.0; 2],
@@ -210,11 +238,29 @@ pub fn accumulate_height(
             acc.flow_sum[0] += c.flow[0];
             acc.flow_sum[1] += c.flow[1];
         }
+        // Beyond the thesis: the nearest sample, and the nearest of another river (whose sample, nearer than
+        // the second, becomes the second when another river's sample comes nearer still).
         if c.dist2 < acc.min_distance2 {
+            if sample.river != acc.nearest_river {
+                acc.second = NearestSample {
+                    distance: acc.min_distance,
+                    distance2: acc.min_distance2,
+                    half_width: acc.nearest_half_width,
+                    river: acc.nearest_river,
+                };
+            }
             acc.min_distance2 = c.dist2;
             acc.min_distance = c.dist;
             acc.nearest_reach = c.reach;
             acc.nearest_half_width = sample.width * 0.5;
+            acc.nearest_river = sample.river;
+        } else if sample.river != acc.nearest_river && c.dist2 < acc.second.distance2 {
+            acc.second = NearestSample {
+                distance: c.dist,
+                distance2: c.dist2,
+                half_width: sample.width * 0.5,
+                river: sample.river,
+            };
         }
     }
     acc
@@ -258,6 +304,9 @@ fn with_lake(mut texel: RiverTexel, acc: &Accumulators) -> RiverTexel {
         texel.water_height = acc.lake_level;
         texel.min_distance = 0.0;
         texel.river_width = LAKE_HALF_WIDTH;
+        // A lake's vertex paints no river band of its own (its distance is the lake's).
+        texel.nearest_sample_width = 0.0;
+        texel.river_order = 0.0;
     }
     texel
 }
@@ -276,6 +325,10 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
             min_distance: params.influence_distance,
             river_width: 0.0,
             flow: [0.0; 2],
+            second_distance: params.influence_distance,
+            second_width: 0.0,
+            nearest_sample_width: 0.0,
+            river_order: 0.0,
         };
     }
     let height = acc.height_sum / acc.weight_sum;
@@ -322,6 +375,27 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
         } else {
             [0.0; 2]
         },
+        ..second_river(acc, params)
+    }
+}
+
+/// Beyond the thesis: the outputs of the second river (docs/rendering.md, "Painted confluences").
+fn second_river(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
+    let second = acc.second.river >= 0.0;
+    RiverTexel {
+        second_distance: if second {
+            acc.second.distance
+        } else {
+            params.influence_distance
+        },
+        second_width: acc.second.half_width,
+        nearest_sample_width: acc.nearest_half_width,
+        river_order: match (second, acc.nearest_river < acc.second.river) {
+            (false, _) => 0.0,
+            (true, true) => 1.0,
+            (true, false) => -1.0,
+        },
+        ..RiverTexel::default()
     }
 }
 

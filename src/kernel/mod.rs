@@ -56,6 +56,17 @@ pub struct RiverTexel {
     /// the samples whose river covers the vertex, weighted as in the river depth (`w_river`); shorter than 1
     /// where they disagree, zero outside every river.
     pub flow: [f32; 2],
+    /// Beyond the thesis (docs/rendering.md, "Painted confluences"): the signed distance to the nearest sample of
+    /// another river than the nearest sample's ([`RiverSample::river`]); the influence distance where none reaches.
+    pub second_distance: f32,
+    /// That sample's half width (0 where none reaches).
+    pub second_width: f32,
+    /// The nearest sample's own half width (0 where none reaches): with `min_distance`, the nearest river's
+    /// band measured as the second river's is.
+    pub nearest_sample_width: f32,
+    /// 1 where the nearest river's number is below the second river's, -1 where above, 0 without a second: the
+    /// shaders put the two in the rivers' order, so that a triangle's vertices agree on which is which.
+    pub river_order: f32,
 }
 
 /// The work for one patch: the grid spacing and the samples that influence it.
@@ -114,7 +125,7 @@ impl<'a> PatchJob<'a> {
 }
 
 /// The names of a texel's outputs, in [`RiverTexel::outputs`] order.
-pub const OUTPUT_NAMES: [&str; 7] = [
+pub const OUTPUT_NAMES: [&str; 11] = [
     "terrain_height",
     "lerp_factor",
     "water_height",
@@ -122,11 +133,15 @@ pub const OUTPUT_NAMES: [&str; 7] = [
     "river_width",
     "flow_x",
     "flow_y",
+    "second_distance",
+    "second_width",
+    "nearest_sample_width",
+    "river_order",
 ];
 
 impl RiverTexel {
     /// The outputs as one array, in [`OUTPUT_NAMES`] order.
-    pub fn outputs(&self) -> [f32; 7] {
+    pub fn outputs(&self) -> [f32; 11] {
         [
             self.terrain_height,
             self.lerp_factor,
@@ -135,6 +150,10 @@ impl RiverTexel {
             self.river_width,
             self.flow[0],
             self.flow[1],
+            self.second_distance,
+            self.second_width,
+            self.nearest_sample_width,
+            self.river_order,
         ]
     }
 }

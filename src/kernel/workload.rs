@@ -50,8 +50,8 @@ pub fn sample_hermite(
     out
 }
 
-/// `count` patches of `grid_size` vertices with spacing `spacing`, each crossed by 1-3 random rivers whose widths
-/// stay below the influence distance.
+/// `count` patches of `grid_size` vertices with spacing `spacing`, each crossed by 1-3 random rivers (numbered
+/// from 1) whose widths stay below the influence distance.
 pub fn random_patches(
     seed: u64,
     count: usize,
@@ -65,7 +65,7 @@ pub fn random_patches(
             let mut rng = Rng::new(seed, &[0x6b65_726e, k as u64]);
             let rivers = 1 + rng.below(3) as usize;
             let mut samples = Vec::new();
-            for _ in 0..rivers {
+            for river in 0..rivers {
                 let point =
                     |rng: &mut Rng| [rng.range(-0.2, 1.2) * extent, rng.range(-0.2, 1.2) * extent];
                 let p0 = point(&mut rng);
@@ -77,15 +77,11 @@ pub fn random_patches(
                 let w0 = rng.range(0.2, 0.6) * params.influence_distance;
                 let w1 = w0 * rng.range(1.0, 1.5);
                 let h0 = rng.range(1.0, 10.0);
-                samples.extend(sample_hermite(
-                    p0,
-                    d0,
-                    p1,
-                    d1,
-                    (h0, h0 * 0.5),
-                    (w0, w1),
-                    6.0,
-                ));
+                samples.extend(
+                    sample_hermite(p0, d0, p1, d1, (h0, h0 * 0.5), (w0, w1), 6.0)
+                        .into_iter()
+                        .map(|s| s.on_river(river as u64 + 1)),
+                );
             }
             (spacing, samples)
         })

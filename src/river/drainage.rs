@@ -71,6 +71,7 @@ pub fn systems(
     }
     let width = |area: f64| reach_width(config, drainage, area);
     let branch = |k: usize| reach_branch(params, k);
+    let rivers = river_keys(reaches, &branch);
     let mut roots: Vec<usize> = (0..reaches.len()).filter(|&k| anchor[k] == k).collect();
     let mouth_area = |k: usize| reaches[k].areas.last().copied().unwrap_or(0.0);
     roots.sort_by(|a, b| mouth_area(*b).total_cmp(&mouth_area(*a)));
@@ -84,7 +85,7 @@ pub fn systems(
             let frame = RiverFrame::new(mouth, source, radius);
             let segments = members
                 .iter()
-                .flat_map(|&k| reach_segments(reaches, (k, 0), &frame, &width, &branch))
+                .flat_map(|&k| reach_segments(reaches, (k, 0), &frame, &width, (&branch, &rivers)))
                 .collect();
             let hull_levels = config.river.hull_levels.min(DRAINAGE_HULL_LEVELS);
             enclose(
@@ -104,15 +105,41 @@ pub fn systems(
     systems
 }
 
+/// The river key of each reach ([`Segment::river`]): a reach that is the largest inflow (by drainage area) of the
+/// reach it joins continues that reach's river; any other is a river's last reach, and the river takes its branch
+/// key.
+fn river_keys(reaches: &[ReachPath], branch: &impl Fn(usize) -> u64) -> Vec<u64> {
+    let area = |k: usize| reaches[k].areas.last().copied().unwrap_or(0.0);
+    let mut main_inflow = vec![usize::MAX; reaches.len()];
+    for (k, r) in reaches.iter().enumerate() {
+        if let Some(d) = r.downstream {
+            let m = main_inflow[d];
+            if m == usize::MAX || area(k) > area(m) {
+                main_inflow[d] = k;
+            }
+        }
+    }
+    (0..reaches.len())
+        .map(|k| {
+            let mut last = k;
+            while let Some(d) = reaches[last].downstream.filter(|&d| main_inflow[d] == last) {
+                last = d;
+            }
+            branch(last)
+        })
+        .collect()
+}
+
 /// The Hermite segments of reach `k` in `frame`, two of its points long, tangents Catmull-Rom; where it joins
 /// another reach, it leaves along the other's first direction: C1 at the confluence (5.2.3). Pieces of
-/// `generation` [`MAX_GENERATION`] spawn no procedural tributaries.
+/// `generation` [`MAX_GENERATION`] spawn no procedural tributaries. `branch`: each reach's branch key; `rivers`:
+/// each reach's river key ([`river_keys`]).
 fn reach_segments(
     reaches: &[ReachPath],
     (k, generation): (usize, u32),
     frame: &RiverFrame,
     width: &impl Fn(f64) -> f32,
-    branch: &impl Fn(usize) -> u64,
+    (branch, rivers): (&impl Fn(usize) -> u64, &[u64]),
 ) -> Vec<Segment> {
     let plane = |p: &DVec3| frame.to_plane(*p).unwrap_or_default();
     let reach = &reaches[k];
@@ -142,6 +169,7 @@ fn reach_segments(
                 generation,
                 branch: branch(k),
                 parent_branch: reach.downstream.map(branch),
+                river: rivers[k],
                 lake: false,
             }
         })
@@ -231,6 +259,7 @@ pub fn stream_systems(
     }
     let width = |area: f64| reach_width(config, drainage, area);
     let branch = |k: usize| rng::hash(params.seed, &[0x7374_7265, level as u64, k as u64]);
+    let rivers = river_keys(streams, &branch);
     // Each level's streams carve valleys half as wide as the coarser level's: the river kernel pulls the terrain
     // within its influence distance towards the bed, and streams a cell apart would otherwise level the hills
     // between them.
@@ -244,7 +273,13 @@ pub fn stream_systems(
             let segments = members
                 .iter()
                 .flat_map(|&k| {
-                    reach_segments(streams, (k, MAX_GENERATION), &frame, &width, &branch)
+                    reach_segments(
+                        streams,
+                        (k, MAX_GENERATION),
+                        &frame,
+                        &width,
+                        (&branch, &rivers),
+                    )
                 })
                 .collect();
             // The hull of the segments themselves: thousands of short pieces, whose descendants the extended
@@ -401,6 +436,7 @@ fn lake_system(
                 generation: 0,
                 branch,
                 parent_branch: None,
+                river: branch,
                 lake: true,
             })
         })

@@ -192,6 +192,7 @@ fn build_system(
                 generation: 0,
                 branch,
                 parent_branch: None,
+                river: branch,
                 lake: false,
             }
         })

@@ -234,7 +234,8 @@ pub fn piece_samples<'a>(
             // A lake's samples say what they are by a negative width (RiverSample).
             (width * stretch) as f32 * if piece.lake { -1.0 } else { 1.0 },
         )
-        .with_reach(system.reach);
+        .with_reach(system.reach)
+        .on_river(piece.river);
         t += sample_step(network, width).max(floor) / speed;
         Some((p, sample))
     })

@@ -103,6 +103,10 @@ pub struct Segment {
     pub branch: u64,
     /// See `branch` (`None` for a main river).
     pub parent_branch: Option<u64>,
+    /// Key of the river this piece lies on, from its source to where it ends: a branch's own, except that a
+    /// drainage river's main stem keeps its key through the confluences where its tributaries join it. Its samples
+    /// carry it ([`crate::shader_types::RiverSample::river`]), so the two rivers of a confluence can be told apart.
+    pub river: u64,
     /// A lake's piece (beyond the thesis, docs/rivers.md): its height is the lake's water level, and its samples
     /// put that level on the vertices within half its width, where the terrain below it is drawn under water.
     pub lake: bool,
@@ -273,6 +277,7 @@ pub fn subdivide(segment: &Segment, params: &SubdivisionParams) -> (Vec<Segment>
             generation: segment.generation + 1,
             branch: key,
             parent_branch: Some(segment.branch),
+            river: key,
             lake: false,
         })
     });
@@ -570,6 +575,7 @@ mod tests {
             generation: 0,
             branch: 7,
             parent_branch: None,
+            river: 7,
             lake: false,
         }
     }

@@ -56,7 +56,7 @@ pub struct Tuned {
 /// Tiled shapes tried (block, tile size): the lavapipe sweep's best (docs/kernel.md), and smaller tiles and larger
 /// blocks that keep more workgroups resident on GPUs with a fixed shared-memory budget per multiprocessor.
 const CANDIDATES: [([u32; 2], u32); 5] = [
-    ([8, 4], 1024),
+    ([8, 4], 992),
     ([8, 4], 256),
     ([8, 8], 256),
     ([16, 8], 512),

@@ -11,21 +11,29 @@ use crate::{
     kernel::{KernelParams, ParentQuadrant, PatchJob, RiverTexel},
 };
 
-/// Decodes one read-back river texture (both layers, tightly packed RGBA32F) into texels.
+/// Decodes one read-back river texture (its layers, tightly packed RGBA32F) into texels.
 pub fn decode_texels(bytes: &[u8], grid_size: u32) -> Vec<RiverTexel> {
     let texels: &[[f32; 4]] = bytemuck::cast_slice(bytes);
-    let (heights, widths) = texels.split_at((grid_size * grid_size) as usize);
+    let (heights, rest) = texels.split_at((grid_size * grid_size) as usize);
+    let (widths, seconds) = rest.split_at((grid_size * grid_size) as usize);
     heights
         .iter()
         .zip(widths)
+        .zip(seconds)
         .map(
-            |(&[terrain_height, lerp_factor, water_height, min_distance], width)| RiverTexel {
-                terrain_height,
-                lerp_factor,
-                water_height,
-                min_distance,
-                river_width: width[0],
-                flow: [width[1], width[2]],
+            |((&[terrain_height, lerp_factor, water_height, min_distance], width), second)| {
+                RiverTexel {
+                    terrain_height,
+                    lerp_factor,
+                    water_height,
+                    min_distance,
+                    river_width: width[0],
+                    flow: [width[1], width[2]],
+                    second_distance: second[0],
+                    second_width: second[1],
+                    nearest_sample_width: second[2],
+                    river_order: second[3],
+                }
             },
         )
         .collect()
@@ -109,7 +117,7 @@ impl BatchOutputs {
             .collect()
     }
 
-    /// Bytes of one patch's two layers, tightly packed.
+    /// Bytes of one patch's layers, tightly packed.
     fn texel_bytes(grid_size: u32) -> u64 {
         (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
     }

@@ -35,10 +35,11 @@ pub enum KernelVariant {
 }
 
 /// Format and layers of a patch's river texture: layer 0 = (terrain height, lerp factor, water height, signed
-/// minimum distance), layer 1 = (river half width, 0, 0, 0).
+/// minimum distance), layer 1 = (river half width, flow x, flow y, 0), layer 2 = (second river's signed distance
+/// and half width, nearest sample's half width, the rivers' order): [`crate::kernel::RiverTexel`].
 pub const RIVER_TEXTURE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 /// See `RIVER_TEXTURE_FORMAT`.
-pub const RIVER_TEXTURE_LAYERS: u32 = 2;
+pub const RIVER_TEXTURE_LAYERS: u32 = 3;
 
 /// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
 /// spacing and samples; and for jobs that take their even vertices from their parent (10.2), the parent's slot
