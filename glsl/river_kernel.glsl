@@ -94,13 +94,16 @@ struct Accumulators {
     float nearestReach;
     // The half width of the nearest sample.
     float nearestHalfWidth;
-    // Beyond the thesis: the nearest sample's river number (-1 before any), and the nearest sample of another
-    // river: its signed distance, the square of it, its half width and river number.
+    // Beyond the thesis: the nearest sample's river number (-1 before any) and how far along its flow the vertex
+    // lies (along2 over scale2, as src/kernel/cpu.rs), and the nearest sample of another river: its signed
+    // distance, the square of it, its half width, river number and the same along the flow.
     float nearestRiver;
+    vec2 nearestAlong;
     float secondDistance;
     float secondDistance2;
     float secondHalfWidth;
     float secondRiver;
+    vec2 secondAlong;
     // Beyond the thesis: the highest level of the lakes whose samples reach the vertex (-FLT_MAX: none).
     float lakeLevel;
     // Beyond the thesis: how far into that lake's reach the vertex lies from the lake's nearest sample, as the
@@ -113,8 +116,8 @@ struct Accumulators {
 
 Accumulators initAccumulators() {
     return Accumulators(0.0, 0.0, 0.0, 0.0, false, 0.0, 0.0, 3.402823466e38, 3.402823466e38,
-                        params.influenceDistance, 0.0, -1.0, 3.402823466e38, 3.402823466e38, 0.0, -1.0,
-                        -3.402823466e38, 1.0, vec2(0.0));
+                        params.influenceDistance, 0.0, -1.0, vec2(0.0, 1.0), 3.402823466e38, 3.402823466e38, 0.0,
+                        -1.0, vec2(0.0, 1.0), -3.402823466e38, 1.0, vec2(0.0));
 }
 
 // A sample with what does not depend on the vertex computed once: the tiled kernel prepares each sample when it
@@ -203,25 +206,37 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
         }
         // Beyond the thesis: the nearest sample, and the nearest of another river.
         float signedDist = side > 0.0 ? -dist : dist;
+        vec2 alongScale = vec2(along2, zero ? 1.0 : dd);
         if (dist2 < acc.minDistance2) {
             if (s.river != acc.nearestRiver) {
                 acc.secondDistance = acc.minDistance;
                 acc.secondDistance2 = acc.minDistance2;
                 acc.secondHalfWidth = acc.nearestHalfWidth;
                 acc.secondRiver = acc.nearestRiver;
+                acc.secondAlong = acc.nearestAlong;
             }
             acc.minDistance2 = dist2;
             acc.minDistance = signedDist;
             acc.nearestReach = reach;
             acc.nearestHalfWidth = s.halfWidth;
             acc.nearestRiver = s.river;
+            acc.nearestAlong = alongScale;
         } else if (s.river != acc.nearestRiver && dist2 < acc.secondDistance2) {
             acc.secondDistance = signedDist;
             acc.secondDistance2 = dist2;
             acc.secondHalfWidth = s.halfWidth;
             acc.secondRiver = s.river;
+            acc.secondAlong = alongScale;
         }
     }
+}
+
+// Beyond the thesis: a half width made negative where the vertex lies beyond the end of its river (`along`: how
+// far along the flow from the river's nearest sample, as along2 and scale2), as beyond_end in src/kernel/cpu.rs.
+float signedWidth(float halfWidth, vec2 along, float spacing) {
+    float limit = max(0.5 * spacing, halfWidth);
+    precise float bound = limit * limit * along.y;
+    return along.x > bound ? -halfWidth : halfWidth;
 }
 
 // Procedure 5: the five outputs of one vertex (patch vertex `xy`), written to the patch's slot.
@@ -234,8 +249,10 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
     vec4 second = vec4(params.influenceDistance, 0.0, 0.0, 0.0);
     if (acc.weightSum > 0.0) {
         bool other = acc.secondRiver >= 0.0;
-        second = vec4(other ? acc.secondDistance : params.influenceDistance, acc.secondHalfWidth,
-                      acc.nearestHalfWidth, other ? (acc.nearestRiver < acc.secondRiver ? 1.0 : -1.0) : 0.0);
+        second = vec4(other ? acc.secondDistance : params.influenceDistance,
+                      other ? signedWidth(acc.secondHalfWidth, acc.secondAlong, job.spacing) : 0.0,
+                      signedWidth(acc.nearestHalfWidth, acc.nearestAlong, job.spacing),
+                      other ? (acc.nearestRiver < acc.secondRiver ? 1.0 : -1.0) : 0.0);
         float height = acc.heightSum / acc.weightSum;
         float basin = acc.basinSum / acc.weightSum;
         // Beyond the thesis: a vertex nearest to a sample with its own, shorter reach (a finer level's stream) has

@@ -59,13 +59,17 @@ float heightAt(PatchInstance p, vec2 grid, float morph) {
 
 // A river pair's slot without a river (see riverPairAt).
 const vec2 NO_RIVER = vec2(FAR_FROM_RIVERS, 0.0);
+// The share of its half width a vertex beyond its river's end draws (see surfaceAt).
+const float BEYOND_END_WIDTH = 1e-3;
 
-// Beyond the thesis (docs/rendering.md, "Painted confluences"): the two nearest rivers at a grid position, signed
-// distance and half width each, in the rivers' order (the lower number first), so that the vertices of a triangle
-// between two rivers agree on which slot holds which; a slot no river fills is NO_RIVER. From layer 2 of the river
-// data (the second river, the nearest sample's half width, the order) and the nearest distance, blended as
-// riverAt blends.
-vec4 riverPairAt(PatchInstance p, vec2 grid, float morph, float nearestDistance) {
+// Beyond the thesis (docs/rendering.md, "The two nearest rivers"): the two nearest rivers at a grid position,
+// signed distance and half width each, in the rivers' order (the lower number first), so that the vertices of a
+// triangle between two rivers agree on which slot holds which; a slot no river fills is NO_RIVER, a river the
+// vertex lies beyond the end of has half width 0 (the kernel's negative half width), so that it narrows to
+// nothing there. From layer 2 of the river data (the second river, the nearest sample's half width, the order) and
+// the nearest distance, blended as riverAt blends; `beyondEnd`: whether the vertex lies beyond the nearest
+// river's end.
+vec4 riverPairAt(PatchInstance p, vec2 grid, float morph, float nearestDistance, out bool beyondEnd) {
     float n = frame.planet.y;
     vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, 2.0);
     vec4 second = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
@@ -73,8 +77,9 @@ vec4 riverPairAt(PatchInstance p, vec2 grid, float morph, float nearestDistance)
         vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, 2.0);
         second = mix(second, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
     }
-    vec2 nearest = second.z > 0.0 ? vec2(nearestDistance, second.z) : NO_RIVER;
-    vec2 other = second.y > 0.0 && second.w != 0.0 ? second.xy : NO_RIVER;
+    beyondEnd = second.z < 0.0;
+    vec2 nearest = second.z != 0.0 ? vec2(nearestDistance, max(second.z, 0.0)) : NO_RIVER;
+    vec2 other = second.w != 0.0 ? vec2(second.x, max(second.y, 0.0)) : NO_RIVER;
     return second.w < 0.0 ? vec4(other, nearest) : vec4(nearest, other);
 }
 
@@ -88,7 +93,12 @@ vec4 surfaceAt(PatchInstance p, vec2 grid, float morph, out vec2 flow, out vec4 
     vec3 widthFlow;
     vec4 river = riverAt(p, grid, morph, widthFlow);
     flow = widthFlow.yz;
-    pair = riverPairAt(p, grid, morph, river.w);
+    bool beyondEnd;
+    pair = riverPairAt(p, grid, morph, river.w, beyondEnd);
+    // Beyond the thesis: beyond its river's end a vertex draws the river narrowed to nothing (a thousandth of its
+    // width, so that it still counts as reached by a river), or the river's band would run on between it and the
+    // vertices beside the river (docs/rendering.md, "The two nearest rivers").
+    if (beyondEnd) widthFlow.x *= BEYOND_END_WIDTH;
     // Section 8.2: blend the river terrain into the base terrain by the lerp factor.
     float height = mix(river.x, base, river.y);
     return vec4(height, max(river.z, frame.sun.w), river.w, widthFlow.x);

@@ -32,7 +32,7 @@ fn straight_river() -> Vec<RiverSample> {
 
 #[test]
 fn vertex_on_the_river_centre_gets_the_river_height() {
-    let t = cpu::calculate_height([10.0, 16.0], &straight_river(), &params());
+    let t = cpu::calculate_height([10.0, 16.0], &straight_river(), 1.0, &params());
     assert!((t.terrain_height - 5.0).abs() < 1e-5, "{t:?}");
     assert_eq!(t.lerp_factor, 0.0);
     assert!(
@@ -47,7 +47,7 @@ fn vertex_on_the_river_centre_gets_the_river_height() {
 #[test]
 fn the_flow_follows_the_river_downstream() {
     let p = params();
-    let t = cpu::calculate_height([10.0, 17.0], &straight_river(), &p);
+    let t = cpu::calculate_height([10.0, 17.0], &straight_river(), 1.0, &p);
     assert!(
         (t.flow[0] - 1.0).abs() < 1e-6 && t.flow[1].abs() < 1e-6,
         "{t:?}"
@@ -55,7 +55,7 @@ fn the_flow_follows_the_river_downstream() {
     let fast: Vec<RiverSample> = (0..=192)
         .map(|k| RiverSample::new([16.0, k as f32 / 6.0], [0.0, -3.0], 5.0, 4.0))
         .collect();
-    let t = cpu::calculate_height([15.0, 10.0], &fast, &p);
+    let t = cpu::calculate_height([15.0, 10.0], &fast, 1.0, &p);
     assert!(
         t.flow[0].abs() < 1e-6 && (t.flow[1] + 1.0).abs() < 1e-6,
         "{t:?}"
@@ -68,7 +68,7 @@ fn the_flow_follows_the_river_downstream() {
             (1..=96).map(|k| RiverSample::new([16.0, 16.0 + k as f32 / 6.0], [0.0, 1.0], 5.0, 4.0)),
         )
         .collect();
-    let t = cpu::calculate_height([17.0, 15.0], &bend, &p);
+    let t = cpu::calculate_height([17.0, 15.0], &bend, 1.0, &p);
     assert!(t.flow[0] > 0.2 && t.flow[1] > 0.2, "{t:?}");
 }
 
@@ -76,10 +76,10 @@ fn the_flow_follows_the_river_downstream() {
 fn basin_rises_cubically_to_the_banks() {
     let samples = straight_river();
     let p = params();
-    let centre = cpu::calculate_height([10.0, 16.0], &samples, &p).terrain_height;
-    let quarter = cpu::calculate_height([10.0, 16.5], &samples, &p).terrain_height;
-    let near_bank = cpu::calculate_height([10.0, 17.9], &samples, &p).terrain_height;
-    let outside = cpu::calculate_height([10.0, 19.0], &samples, &p);
+    let centre = cpu::calculate_height([10.0, 16.0], &samples, 1.0, &p).terrain_height;
+    let quarter = cpu::calculate_height([10.0, 16.5], &samples, 1.0, &p).terrain_height;
+    let near_bank = cpu::calculate_height([10.0, 17.9], &samples, 1.0, &p).terrain_height;
+    let outside = cpu::calculate_height([10.0, 19.0], &samples, 1.0, &p);
     assert!(
         centre < quarter && quarter < near_bank,
         "{centre} {quarter} {near_bank}"
@@ -97,8 +97,8 @@ fn basin_rises_cubically_to_the_banks() {
 #[test]
 fn signed_distance_flips_across_the_river() {
     let samples = straight_river();
-    let left = cpu::calculate_height([10.0, 18.5], &samples, &params());
-    let right = cpu::calculate_height([10.0, 13.5], &samples, &params());
+    let left = cpu::calculate_height([10.0, 18.5], &samples, 1.0, &params());
+    let right = cpu::calculate_height([10.0, 13.5], &samples, 1.0, &params());
     assert!(
         left.min_distance < 0.0 && right.min_distance > 0.0,
         "{left:?} {right:?}"
@@ -111,7 +111,7 @@ fn lerp_factor_grows_from_bank_to_influence_distance() {
     let p = params();
     let mut last = -1.0;
     for y in [19.0f32, 22.0, 26.0, 30.0, 34.0] {
-        let t = cpu::calculate_height([10.0, y], &samples, &p);
+        let t = cpu::calculate_height([10.0, y], &samples, 1.0, &p);
         assert!(
             t.lerp_factor > last && (0.0..=1.0).contains(&t.lerp_factor),
             "{y}: {t:?}"
@@ -129,7 +129,7 @@ fn lerp_factor_grows_from_bank_to_influence_distance() {
 fn a_lake_gives_its_level_to_the_vertices_it_reaches() {
     let p = params();
     let lake = RiverSample::new([10.0, 10.0], [1.0, 0.0], 3.0, -8.0);
-    let t = cpu::calculate_height([12.0, 10.0], &[lake], &p);
+    let t = cpu::calculate_height([12.0, 10.0], &[lake], 1.0, &p);
     assert_eq!(t.water_height, 3.0);
     assert_eq!((t.min_distance, t.river_width), (0.0, cpu::LAKE_HALF_WIDTH));
     assert_eq!(
@@ -138,14 +138,14 @@ fn a_lake_gives_its_level_to_the_vertices_it_reaches() {
         "the planet's own terrain"
     );
     // Beyond half its width the lake is not there.
-    let beyond = cpu::calculate_height([15.0, 10.0], &[lake], &p);
-    assert_eq!(beyond, cpu::calculate_height([15.0, 10.0], &[], &p));
+    let beyond = cpu::calculate_height([15.0, 10.0], &[lake], 1.0, &p);
+    assert_eq!(beyond, cpu::calculate_height([15.0, 10.0], &[], 1.0, &p));
     // In a river's basin above the lake's level (an inflow), 2.5 into the lake's reach of 4: the water keeps
     // (2.5 / 4)^2 of its excess over the level, and the bed falls with it.
     let mut both = straight_river();
     both.push(RiverSample::new([10.0, 14.0], [1.0, 0.0], 4.0, -8.0));
-    let in_river = cpu::calculate_height([10.0, 16.5], &both, &p);
-    let river_only = cpu::calculate_height([10.0, 16.5], &straight_river(), &p);
+    let in_river = cpu::calculate_height([10.0, 16.5], &both, 1.0, &p);
+    let river_only = cpu::calculate_height([10.0, 16.5], &straight_river(), 1.0, &p);
     let excess = river_only.water_height - 4.0;
     assert!(excess > 0.5, "{river_only:?}");
     let kept = (2.5f32 / 4.0).powi(2);
@@ -171,17 +171,20 @@ fn a_lake_gives_its_level_to_the_vertices_it_reaches() {
     // On the lake's line the inflow's water is at the level.
     let mut lake_line = straight_river();
     lake_line.push(RiverSample::new([10.0, 16.0], [1.0, 0.0], 4.0, -8.0));
-    let mouth = cpu::calculate_height([10.0, 16.0], &lake_line, &p);
+    let mouth = cpu::calculate_height([10.0, 16.0], &lake_line, 1.0, &p);
     assert_eq!(mouth.water_height, 4.0);
     // A river below the lake's level (an outlet) keeps its water.
     let mut outlet = straight_river();
     outlet.push(RiverSample::new([10.0, 14.0], [1.0, 0.0], 7.0, -8.0));
-    assert_eq!(cpu::calculate_height([10.0, 16.5], &outlet, &p), river_only);
+    assert_eq!(
+        cpu::calculate_height([10.0, 16.5], &outlet, 1.0, &p),
+        river_only
+    );
     // Beside the river, the lake's level, with the river's lerp factor; the river's terrain (its valley floor,
     // here above the level), 2 into the lake's reach of 4, keeps (2 / 4)^2 of its excess, as an inflow's water:
     // the drawn ground does not stand above the lake's water at its points.
-    let beside = cpu::calculate_height([10.0, 12.0], &both, &p);
-    let river_beside = cpu::calculate_height([10.0, 12.0], &straight_river(), &p);
+    let beside = cpu::calculate_height([10.0, 12.0], &both, 1.0, &p);
+    let river_beside = cpu::calculate_height([10.0, 12.0], &straight_river(), 1.0, &p);
     assert_eq!(beside.water_height, 4.0);
     assert_eq!(beside.lerp_factor, river_beside.lerp_factor);
     let excess = river_beside.terrain_height - 4.0;
@@ -197,7 +200,7 @@ fn no_relevant_sample_keeps_the_base_terrain() {
     let far = [RiverSample::new([500.0, 500.0], [1.0, 0.0], 5.0, 4.0)];
     let p = params();
     for samples in [&far[..], &[]] {
-        let t = cpu::calculate_height([1.0, 1.0], samples, &p);
+        let t = cpu::calculate_height([1.0, 1.0], samples, 1.0, &p);
         assert_eq!(
             t,
             RiverTexel {
@@ -235,24 +238,35 @@ fn vertices_between_two_rivers_measure_both() {
         [other, main].concat(),
     ] {
         // Nearer the wide river: it is the nearest, the narrow one second (left of its flow: negative).
-        let t = cpu::calculate_height([10.0, 18.0], &samples, &p);
+        let t = cpu::calculate_height([10.0, 18.0], &samples, 1.0, &p);
         assert!((t.min_distance - -2.0).abs() < 1e-4, "{t:?}");
         assert!((t.second_distance - 4.0).abs() < 1e-4, "{t:?}");
         assert_eq!((t.nearest_sample_width, t.second_width), (2.0, 1.0));
         assert_eq!(t.river_order, -1.0, "river 7 nearest, 3 second");
         // Nearer the narrow one: the order turns.
-        let t = cpu::calculate_height([10.0, 21.0], &samples, &p);
+        let t = cpu::calculate_height([10.0, 21.0], &samples, 1.0, &p);
         assert!((t.min_distance - 1.0).abs() < 1e-4, "{t:?}");
         assert!((t.second_distance - -5.0).abs() < 1e-4, "{t:?}");
         assert_eq!(t.river_order, 1.0);
     }
     // One river alone: no second.
-    let t = cpu::calculate_height([10.0, 18.0], &straight_river(), &p);
+    let t = cpu::calculate_height([10.0, 18.0], &straight_river(), 1.0, &p);
     assert_eq!(
         (t.second_distance, t.second_width, t.river_order),
         (p.influence_distance, 0.0, 0.0)
     );
     assert_eq!(t.nearest_sample_width, 2.0);
+    // Beyond the river's end (it runs from x = 0 to 32) by more than its half width and half a spacing: the half
+    // width turns negative, for the shaders to narrow the river to nothing there; within them it stays.
+    let beyond = cpu::calculate_height([36.0, 17.0], &straight_river(), 1.0, &p);
+    assert_eq!(beyond.nearest_sample_width, -2.0);
+    let near_end = cpu::calculate_height([33.5, 17.0], &straight_river(), 1.0, &p);
+    assert_eq!(near_end.nearest_sample_width, 2.0);
+    let coarse = cpu::calculate_height([36.0, 17.0], &straight_river(), 10.0, &p);
+    assert_eq!(
+        coarse.nearest_sample_width, 2.0,
+        "within half of a 10-unit spacing"
+    );
 }
 
 #[test]
@@ -267,7 +281,7 @@ fn degenerate_derivative_and_border_vertices_stay_finite() {
         ([5.0, 6.0], &single),
         ([5.0, 5.0], &single),
     ] {
-        let t = cpu::calculate_height(v, s, &p);
+        let t = cpu::calculate_height(v, s, 1.0, &p);
         for x in [
             t.terrain_height,
             t.lerp_factor,

@@ -83,8 +83,9 @@ fn survey(world: &World) -> Findings {
                 if !inside(centre) {
                     continue;
                 }
-                let kernel =
-                    |q: DVec2| calculate_height([q.x as f32, q.y as f32], &samples, &params);
+                let kernel = |q: DVec2| {
+                    calculate_height([q.x as f32, q.y as f32], &samples, spacing as f32, &params)
+                };
                 let texel = kernel(centre);
                 let water = texel.water_height as f64;
                 if water <= sea + 1e-6 {
@@ -224,7 +225,12 @@ fn lakes_are_drawn_as_water_at_their_level() {
             let frame = PatchFrame::new(patch, world.planet.radius, n);
             let samples = patch_samples(&world.network, &frame).samples;
             let at = frame.to_patch(p);
-            let t = calculate_height([at.x as f32, at.y as f32], &samples, &params);
+            let t = calculate_height(
+                [at.x as f32, at.y as f32],
+                &samples,
+                frame.spacing() as f32,
+                &params,
+            );
             // The water stands over the drawn ground: the planet's own, blended into a river's valley near one.
             let base = world.planet.height_at(p);
             let ground = t.terrain_height + (base - t.terrain_height) * t.lerp_factor;

@@ -34,6 +34,12 @@ pub struct SampleContribution {
     pub dist: f32,
     /// The squared distance: the nearest sample is chosen on it, exactly alike on every device.
     pub dist2: f32,
+    /// Beyond the thesis: the squared distance along the flow times `scale2` (`(r.d)^2`; `dist2` for a zero
+    /// derivative), and `scale2` (`|d|^2`; 1 for a zero derivative): whether the vertex lies beyond a river's end
+    /// is decided on them ([`beyond_end`]).
+    pub along2: f32,
+    /// See `along2`.
+    pub scale2: f32,
     /// The sample's influence distance (beyond the thesis: [`RiverSample::reach`]).
     pub reach: f32,
     /// Beyond the thesis: the sample's unit direction (downstream) times `w_river`, for the water's flow.
@@ -101,6 +107,8 @@ pub fn calculate_height_by_sample(
         w_river: 0.0,
         dist: if side > 0.0 { -dist } else { dist },
         dist2,
+        along2,
+        scale2: if zero { 1.0 } else { dd },
         reach,
         flow: [0.0; 2],
     };
@@ -147,8 +155,8 @@ pub struct Accumulators {
     pub nearest_reach: f32,
     /// The half width of the nearest sample.
     pub nearest_half_width: f32,
-    /// Beyond the thesis: the nearest sample's river number (-1 before any).
-    pub nearest_river: f32,
+    /// Beyond the thesis: the nearest sample (again, with its river and how far along its flow the vertex lies).
+    pub nearest: NearestSample,
     /// Beyond the thesis: the nearest sample of another river than the nearest sample's.
     pub second: NearestSample,
     /// Beyond the thesis: the highest water level of the lake samples within half their width of the vertex
@@ -161,7 +169,8 @@ pub struct Accumulators {
     pub flow_sum: [f32; 2],
 }
 
-/// The nearest sample of a river: its signed distance, the square of it, its half width and its river number.
+/// The nearest sample of a river: its signed distance, the square of it, its half width, its river number and
+/// how far along the flow the vertex lies from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NearestSample {
     /// The signed distance ([`SampleContribution::dist`]).
@@ -172,6 +181,10 @@ pub struct NearestSample {
     pub half_width: f32,
     /// The sample's river number (-1: none yet).
     pub river: f32,
+    /// [`SampleContribution::along2`] and [`SampleContribution::scale2`].
+    pub along2: f32,
+    /// See `along2`.
+    pub scale2: f32,
 }
 
 impl NearestSample {
@@ -180,7 +193,31 @@ impl NearestSample {
         distance2: f32::MAX,
         half_width: 0.0,
         river: -1.0,
+        along2: 0.0,
+        scale2: 1.0,
     };
+
+    fn of(c: &SampleContribution, sample: &RiverSample) -> Self {
+        Self {
+            distance: c.dist,
+            distance2: c.dist2,
+            half_width: sample.width * 0.5,
+            river: sample.river,
+            along2: c.along2,
+            scale2: c.scale2,
+        }
+    }
+}
+
+/// Beyond the thesis (docs/rendering.md, "The two nearest rivers"): whether a vertex lies beyond the end of the
+/// river whose `nearest` sample it measured: farther along the flow from it than half a vertex `spacing` and its
+/// half width. Beside a river its nearest sample lies within half a sample step along the flow (at most an eighth of
+/// the spacing), so only an end's sample is that far; its signed distance changes sign along the line the river
+/// points, which interpolated between vertices would paint the river on beyond its end. Decided on products, alike
+/// on every device.
+pub fn beyond_end(nearest: &NearestSample, spacing: f32) -> bool {
+    let limit = (0.5 * spacing).max(nearest.half_width);
+    nearest.along2 > limit * limit * nearest.scale2
 }
 
 /// Procedure 4, Section 6.5: accumulate the weighted contributions of every relevant sample.
@@ -201,7 +238,7 @@ pub fn accumulate_height(
         min_distance2: f32::MAX,
         nearest_reach: params.influence_distance,
         nearest_half_width: 0.0,
-        nearest_river: -1.0,
+        nearest: NearestSample::NONE,
         second: NearestSample::NONE,
         lake_level: -f32::MAX,
         lake_offset2: 1.0,
@@ -241,36 +278,31 @@ pub fn accumulate_height(
         // Beyond the thesis: the nearest sample, and the nearest of another river (whose sample, nearer than
         // the second, becomes the second when another river's sample comes nearer still).
         if c.dist2 < acc.min_distance2 {
-            if sample.river != acc.nearest_river {
-                acc.second = NearestSample {
-                    distance: acc.min_distance,
-                    distance2: acc.min_distance2,
-                    half_width: acc.nearest_half_width,
-                    river: acc.nearest_river,
-                };
+            if sample.river != acc.nearest.river {
+                acc.second = acc.nearest;
             }
             acc.min_distance2 = c.dist2;
             acc.min_distance = c.dist;
             acc.nearest_reach = c.reach;
             acc.nearest_half_width = sample.width * 0.5;
-            acc.nearest_river = sample.river;
-        } else if sample.river != acc.nearest_river && c.dist2 < acc.second.distance2 {
-            acc.second = NearestSample {
-                distance: c.dist,
-                distance2: c.dist2,
-                half_width: sample.width * 0.5,
-                river: sample.river,
-            };
+            acc.nearest = NearestSample::of(&c, sample);
+        } else if sample.river != acc.nearest.river && c.dist2 < acc.second.distance2 {
+            acc.second = NearestSample::of(&c, sample);
         }
     }
     acc
 }
 
 /// Procedure 5, Section 6.6: the final terrain height, lerp factor, water height, signed minimum distance and
-/// river (half) width of one vertex.
-pub fn calculate_height(v: [f32; 2], samples: &[RiverSample], params: &KernelParams) -> RiverTexel {
+/// river (half) width of one vertex; beyond the thesis, the second river, for a patch of vertices `spacing` apart.
+pub fn calculate_height(
+    v: [f32; 2],
+    samples: &[RiverSample],
+    spacing: f32,
+    params: &KernelParams,
+) -> RiverTexel {
     let acc = accumulate_height(v, samples, params);
-    let texel = river_outputs(&acc, params);
+    let texel = with_second_river(river_outputs(&acc, params), &acc, spacing, params);
     with_lake(texel, &acc)
 }
 
@@ -325,10 +357,7 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
             min_distance: params.influence_distance,
             river_width: 0.0,
             flow: [0.0; 2],
-            second_distance: params.influence_distance,
-            second_width: 0.0,
-            nearest_sample_width: 0.0,
-            river_order: 0.0,
+            ..RiverTexel::default()
         };
     }
     let height = acc.height_sum / acc.weight_sum;
@@ -375,12 +404,26 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
         } else {
             [0.0; 2]
         },
-        ..second_river(acc, params)
+        ..RiverTexel::default()
     }
 }
 
-/// Beyond the thesis: the outputs of the second river (docs/rendering.md, "Painted confluences").
-fn second_river(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
+/// Beyond the thesis (docs/rendering.md, "The two nearest rivers"): `texel` with the second river's outputs, and
+/// the nearest sample's own half width; each half width negative where the vertex lies [`beyond_end`] of that
+/// river, for the shaders to narrow the river to nothing there.
+fn with_second_river(
+    texel: RiverTexel,
+    acc: &Accumulators,
+    spacing: f32,
+    params: &KernelParams,
+) -> RiverTexel {
+    let signed_width = |s: &NearestSample| {
+        if beyond_end(s, spacing) {
+            -s.half_width
+        } else {
+            s.half_width
+        }
+    };
     let second = acc.second.river >= 0.0;
     RiverTexel {
         second_distance: if second {
@@ -388,14 +431,18 @@ fn second_river(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
         } else {
             params.influence_distance
         },
-        second_width: acc.second.half_width,
-        nearest_sample_width: acc.nearest_half_width,
-        river_order: match (second, acc.nearest_river < acc.second.river) {
+        second_width: if second {
+            signed_width(&acc.second)
+        } else {
+            0.0
+        },
+        nearest_sample_width: signed_width(&acc.nearest),
+        river_order: match (second, acc.nearest.river < acc.second.river) {
             (false, _) => 0.0,
             (true, true) => 1.0,
             (true, false) => -1.0,
         },
-        ..RiverTexel::default()
+        ..texel
     }
 }
 
@@ -406,6 +453,7 @@ pub fn compute_patch(job: &PatchJob, n: u32, params: &KernelParams) -> Vec<River
             calculate_height(
                 vertex_position(k % n, k / n, job.spacing),
                 job.samples,
+                job.spacing,
                 params,
             )
         })
@@ -426,7 +474,12 @@ pub fn compute_patch_from_parent(
             let (i, j) = (k % n, k / n);
             match quadrant.parent_vertex(i, j) {
                 Some((pi, pj)) => parent[(pj * n + pi) as usize],
-                None => calculate_height(vertex_position(i, j, job.spacing), job.samples, params),
+                None => calculate_height(
+                    vertex_position(i, j, job.spacing),
+                    job.samples,
+                    job.spacing,
+                    params,
+                ),
             }
         })
         .collect()
@@ -455,6 +508,7 @@ pub fn compute_patches_rayon(
                         *texel = calculate_height(
                             vertex_position(i as u32, j as u32, job.spacing),
                             job.samples,
+                            job.spacing,
                             params,
                         );
                     }
