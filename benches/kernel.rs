@@ -18,6 +18,7 @@ fn kernel(c: &mut Criterion) {
         basin_depth: 0.1,
         sea_level: 0.4,
         basin_water_offset: 0.001,
+        sample_floor: 0.25,
     };
     let n = 33;
     let patches: Vec<_> = (0..6u32)

@@ -48,6 +48,8 @@ layout(push_constant) uniform KernelParams {
     uint gridSize;
     // Row of the job table that workgroup index 0 computes: rows are dispatched in groups of the same lattice.
     uint firstJob;
+    // Beyond the thesis: the least distance between samples, in vertex spacings (0: none; signedWidth).
+    float sampleFloor;
 } params;
 
 uint latticeStride(PatchJob job) {
@@ -234,7 +236,7 @@ void accumulateSample(inout Accumulators acc, vec2 v, PreparedSample s) {
 // Beyond the thesis: a half width made negative where the vertex lies beyond the end of its river (`along`: how
 // far along the flow from the river's nearest sample, as along2 and scale2), as beyond_end in src/kernel/cpu.rs.
 float signedWidth(float halfWidth, vec2 along, float spacing) {
-    float limit = max(0.5 * spacing, halfWidth);
+    float limit = max(params.sampleFloor * spacing, halfWidth);
     precise float bound = limit * limit * along.y;
     return along.x > bound ? -halfWidth : halfWidth;
 }

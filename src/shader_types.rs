@@ -111,9 +111,11 @@ pub struct KernelPush {
     pub grid_size: u32,
     /// The job-table row that workgroup index 0 computes (rows are dispatched in groups of one lattice).
     pub first_job: u32,
+    /// [`crate::kernel::KernelParams::sample_floor`].
+    pub sample_floor: f32,
 }
 
-const _: () = assert!(size_of::<KernelPush>() == 24);
+const _: () = assert!(size_of::<KernelPush>() == 28);
 const _: () = assert!(offset_of!(KernelPush, grid_size) == 16);
 
 /// The tiled kernel's specialization constants (glsl/kernel_tiled.comp, constant_id 0 to 4 in field order).

@@ -20,6 +20,7 @@ fn params() -> KernelParams {
         basin_depth: 0.1,
         sea_level: 0.4,
         basin_water_offset: 0.001,
+        sample_floor: 0.25,
     }
 }
 
@@ -256,16 +257,17 @@ fn vertices_between_two_rivers_measure_both() {
         (p.influence_distance, 0.0, 0.0)
     );
     assert_eq!(t.nearest_sample_width, 2.0);
-    // Beyond the river's end (it runs from x = 0 to 32) by more than its half width and half a spacing: the half
-    // width turns negative, for the shaders to narrow the river to nothing there; within them it stays.
+    // Beyond the river's end (it runs from x = 0 to 32) by more than its half width and the samples' floor (a
+    // quarter of the spacing here): the half width turns negative, for the shaders to narrow the river to nothing
+    // there; within them it stays.
     let beyond = cpu::calculate_height([36.0, 17.0], &straight_river(), 1.0, &p);
     assert_eq!(beyond.nearest_sample_width, -2.0);
     let near_end = cpu::calculate_height([33.5, 17.0], &straight_river(), 1.0, &p);
     assert_eq!(near_end.nearest_sample_width, 2.0);
-    let coarse = cpu::calculate_height([36.0, 17.0], &straight_river(), 10.0, &p);
+    let coarse = cpu::calculate_height([36.0, 17.0], &straight_river(), 20.0, &p);
     assert_eq!(
         coarse.nearest_sample_width, 2.0,
-        "within half of a 10-unit spacing"
+        "within a quarter of a 20-unit spacing"
     );
 }
 

@@ -209,14 +209,14 @@ impl NearestSample {
     }
 }
 
-/// Beyond the thesis (docs/rendering.md, "The two nearest rivers"): whether a vertex lies beyond the end of the
-/// river whose `nearest` sample it measured: farther along the flow from it than half a vertex `spacing` and its
-/// half width. Beside a river its nearest sample lies within half a sample step along the flow (at most an eighth of
-/// the spacing), so only an end's sample is that far; its signed distance changes sign along the line the river
-/// points, which interpolated between vertices would paint the river on beyond its end. Decided on products, alike
-/// on every device.
-pub fn beyond_end(nearest: &NearestSample, spacing: f32) -> bool {
-    let limit = (0.5 * spacing).max(nearest.half_width);
+/// Beyond the thesis (docs/rendering.md, "Rivers end where they end"): whether a vertex lies beyond the end of the
+/// river whose `nearest` sample it measured: farther along the flow from it than the samples' floor (`sample_floor`
+/// vertex spacings) and its half width. Beside a river its nearest sample lies within half a sample step along the
+/// flow (half the floor, or a twelfth of the width), so only an end's sample is that far; its signed distance
+/// changes sign along the line the river points, which interpolated between vertices would paint the river on
+/// beyond its end. Decided on products, alike on every device.
+pub fn beyond_end(nearest: &NearestSample, spacing: f32, sample_floor: f32) -> bool {
+    let limit = (sample_floor * spacing).max(nearest.half_width);
     nearest.along2 > limit * limit * nearest.scale2
 }
 
@@ -418,7 +418,7 @@ fn with_second_river(
     params: &KernelParams,
 ) -> RiverTexel {
     let signed_width = |s: &NearestSample| {
-        if beyond_end(s, spacing) {
+        if beyond_end(s, spacing, params.sample_floor) {
             -s.half_width
         } else {
             s.half_width

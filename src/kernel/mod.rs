@@ -24,6 +24,10 @@ pub struct KernelParams {
     pub sea_level: f32,
     /// How far the water surface lies below the basin's top (Procedure 5).
     pub basin_water_offset: f32,
+    /// Beyond the thesis: the least distance between samples along a river, in vertex spacings (1 /
+    /// `samples-per-vertex-spacing`; 0: no such floor): a vertex beside a river lies within half of it along the
+    /// flow from the river's nearest sample, which tells a river's end apart ([`cpu::beyond_end`]).
+    pub sample_floor: f32,
 }
 
 impl KernelParams {
@@ -34,6 +38,10 @@ impl KernelParams {
             basin_depth: config.river.basin_depth,
             sea_level: config.planet.sea_level_height,
             basin_water_offset: config.river.basin_water_offset,
+            sample_floor: match config.river.samples_per_vertex_spacing {
+                0 => 0.0,
+                k => 1.0 / k as f32,
+            },
         }
     }
 }

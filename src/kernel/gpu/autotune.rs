@@ -121,6 +121,7 @@ pub fn measure(ctx: &Context, grid_size: u32) -> Result<Tuned, GpuError> {
         basin_depth: 0.1,
         sea_level: 0.0,
         basin_water_offset: 0.001,
+        sample_floor: 0.25,
     };
     // Rivers a twentieth to a fifth of the influence distance wide, as the planet's are at the levels where most
     // patches are made (the generator draws widths in proportion to the distance it is given).

@@ -194,6 +194,7 @@ impl RiverKernel {
             basin_water_offset: params.basin_water_offset,
             grid_size: n,
             first_job: first_job as u32,
+            sample_floor: params.sample_floor,
         };
         let inputs = [&sample_buffer, &job_buffer];
         let dispatched = match variant {
