@@ -218,7 +218,7 @@ fn the_network_diffusivity_lies_between_0_and_a_thousandth() {
         "[0, 0.001]",
     );
     let planet = Config::defaults_for(RiverModel::Drainage).planet;
-    assert_eq!(planet.network_diffusivity, 0.0);
+    assert_eq!(planet.network_diffusivity, 2e-4);
 }
 
 #[test]

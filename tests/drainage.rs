@@ -104,10 +104,10 @@ fn a_pit_becomes_a_lake_at_its_spill_height_and_rivers_form_trees() {
     let l = lattice(48, dome);
     let grid = SphereGrid::new(&l);
     let heights = grid.values(&l);
-    let routing = route(&grid, &heights, 0.0);
+    let mut routing = route(&grid, &heights, 0.0);
     let network = extract(
         &grid,
-        &routing,
+        &mut routing,
         &heights,
         0.0,
         Thresholds {
@@ -170,9 +170,11 @@ fn assert_natural(config: &riverplanet::config::Config, seed: u32) {
     );
     assert!(m.drained_land_fraction >= 0.6, "seed {seed}: {m:?}");
     assert!(m.confluences > 100 && m.rivers > 10);
-    // D8 lets three rivers or more meet at one node; most junctions stay binary, as real ones are.
+    // D8 lets three rivers or more meet at one node (16-18 % of the confluences on seeds 1-3); the extraction turns
+    // all but the two largest to another lower neighbour where one allows it (drainage/junctions.rs), so most
+    // junctions are binary, as real ones are (5-8 % left).
     assert!(
-        m.multiple_junctions > 0 && 4 * m.multiple_junctions <= m.confluences,
+        m.multiple_junctions > 0 && 10 * m.multiple_junctions <= m.confluences,
         "seed {seed}: {} of {} confluences join three rivers or more",
         m.multiple_junctions,
         m.confluences

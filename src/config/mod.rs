@@ -311,6 +311,7 @@ impl Config {
         if model == RiverModel::Drainage {
             d.planet.relief_model = ReliefModel::Eroded;
             d.planet.detail_amplitude = 2.0;
+            d.planet.network_diffusivity = 2e-4;
             d.river.source_area = d.planet.relief_model.source_area();
             d.river.samples_per_vertex_spacing = 4;
             d.river.stream_levels = 1;

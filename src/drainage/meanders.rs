@@ -21,8 +21,11 @@ pub const WAVELENGTH_WIDTHS: f64 = 11.0;
 const FLAT_SWING: f64 = 1.25;
 /// The valley slope (drop over run, as a share of the planet's relief over its radius) at which the swing has
 /// fallen to half of the flat one. The median order-3 reach of the default planet has 0.22. At 0.5 seed 3's median
-/// stream sinuosity was 1.23, below the 1.3-1.6 of real lowland rivers; 0.7 gives 1.27-1.36 on seeds 1-6.
-const HALF_SWING_SLOPE: f64 = 0.7;
+/// stream sinuosity was 1.23, below the 1.3-1.6 of real lowland rivers; on the diffused relief with binary
+/// junctions (docs/planet.md, "Diffusion while the network forms") 0.7 gave 1.248 / 1.267 / 1.252 on seeds 1-3 and
+/// 0.8 gives 1.253 / 1.276 / 1.271; 1.0 gave 1.269 / 1.286 / 1.292, but level 4 then painted the meanders below
+/// its spacing too far from level 6's (tests/render.rs).
+const HALF_SWING_SLOPE: f64 = 0.8;
 /// The curvature at the apex of the tightest meander a river of `half_width` draws (a flat valley's): a
 /// sine-generated course turns at most `2 pi swing / wavelength` per unit of length.
 pub fn apex_curvature(half_width: f64) -> f64 {
@@ -210,10 +213,11 @@ pub fn sine_course(
     }
     // Onto the valley's ends exactly (the integration leaves a little drift).
     let (end_x, end_y) = *course.last().expect("not empty");
-    // Near its ends the course eases onto the valley line over half a wavelength, so a tributary meets its main
-    // stem along its valley instead of swinging across the other's course.
+    // Near its ends the course eases onto the valley line over a quarter wavelength, so a tributary meets its main
+    // stem along its valley instead of swinging across the other's course (over half a wavelength, the short base
+    // reaches of the diffused relief barely wound: docs/planet.md, "Diffusion while the network forms").
     let ease = |x: f64| {
-        let t = (x.min(length - x) / (0.5 * wavelength)).clamp(0.0, 1.0);
+        let t = (x.min(length - x) / (0.25 * wavelength)).clamp(0.0, 1.0);
         t * t * (3.0 - 2.0 * t)
     };
     course
@@ -422,8 +426,9 @@ mod tests {
 
     #[test]
     fn a_steep_river_stays_straight_and_a_creek_is_left_to_finer_levels() {
-        // A drop of 16 over 40 cells (500 units) is a slope of 0.031, twice the relief slope.
-        let steep = meander(&straight_reach(40, 16.0), &scale(), &|_| 1.0);
+        // A drop of 24 over 40 cells (500 units) is a slope of 0.047, three times the relief slope (fourteen times
+        // the median order-3 reach's): a swing of a tenth of the flat one.
+        let steep = meander(&straight_reach(40, 24.0), &scale(), &|_| 1.0);
         assert!(sinuosity(&steep) < 1.01, "{}", sinuosity(&steep));
         let creek = meander(&straight_reach(40, 0.2), &scale(), &|_| 0.1);
         assert_eq!(creek.points.len(), 41);

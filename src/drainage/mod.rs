@@ -6,6 +6,7 @@
 pub mod drawn;
 pub mod finer;
 pub mod grid;
+pub mod junctions;
 pub mod meanders;
 pub mod rivers;
 pub mod routing;
@@ -93,10 +94,10 @@ pub fn drain_paths(
     let heights = grid.values(lattice);
     let sea_level = planet.sea_level_height as f64;
     let radius = planet.radius as f64;
-    let routing = route(grid, &heights, sea_level);
+    let mut routing = route(grid, &heights, sea_level);
     let network = extract(
         grid,
-        &routing,
+        &mut routing,
         &heights,
         sea_level,
         Thresholds {

@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use super::{
     grid::SphereGrid,
+    junctions::split_junctions,
     routing::{Routing, NONE},
 };
 
@@ -88,10 +89,10 @@ pub struct Thresholds {
 }
 
 /// Extracts rivers and lakes from `routing` over `heights` (the unfilled heights; nodes at or below `sea_level`
-/// are sea).
+/// are sea), after splitting the junctions of three rivers or more in `routing` ([`split_junctions`]).
 pub fn extract(
     grid: &SphereGrid,
-    routing: &Routing,
+    routing: &mut Routing,
     heights: &[f64],
     sea_level: f64,
     thresholds: Thresholds,
@@ -99,6 +100,9 @@ pub fn extract(
     let n = grid.len();
     let sea = |k: usize| heights[k] <= sea_level;
     let (lakes, lake_of) = lakes(grid, routing, heights, sea_level, thresholds.lake_depth);
+    let channel = |k: usize| !sea(k) && lake_of[k].is_none();
+    split_junctions(grid, routing, channel, thresholds.river_area);
+    let routing = &*routing;
     let river: Vec<bool> = (0..n)
         .map(|k| !sea(k) && lake_of[k].is_none() && routing.area[k] >= thresholds.river_area)
         .collect();

@@ -80,6 +80,12 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
         crossing: 0,
     };
     uncross_diagonals(grid, &mut routing);
+    routing.area = accumulate(grid, &routing);
+    routing
+}
+
+/// Drainage area on the unit sphere: each node's own area plus everything that drains through it.
+pub fn accumulate(grid: &SphereGrid, routing: &Routing) -> Vec<f64> {
     let mut area = grid.areas.clone();
     for &k in &routing.upstream_first {
         let r = routing.receiver[k as usize];
@@ -87,8 +93,7 @@ pub fn route(grid: &SphereGrid, heights: &[f64], sea_level: f64) -> Routing {
             area[r as usize] += area[k as usize];
         }
     }
-    routing.area = area;
-    routing
+    area
 }
 
 /// The neighbour of `node` with the steepest descent on `filled` (drop over angle), leaving out `except`;

@@ -644,8 +644,8 @@ mod tests {
 
     #[test]
     fn steep_rivers_long_pieces_the_first_levels_and_the_thesis_keep_its_subdivision() {
-        // A slope of twice the relief slope.
-        let steep = straight(66.0, 2.0, 2.0 * 16.0 / 1024.0 * 66.0);
+        // A slope of three times the relief slope (a tenth of the flat swing).
+        let steep = straight(66.0, 2.0, 3.0 * 16.0 / 1024.0 * 66.0);
         let steep = sinuosity(&subdivide(&steep, &params(true)).0);
         assert!(steep < 1.01, "{steep}");
         // Fifty wavelengths: left to the finer pieces.
