@@ -104,7 +104,7 @@ pub struct PlanetConfig {
     /// from the sea, so continental interiors stand higher than their coastal plains (0: one lowland uplift).
     pub interior_rise: f32,
     /// Eroded relief (beyond the thesis): hillslope diffusivity of the young relief while its drainage network
-    /// forms (unit-sphere area per model time; 0, the default: the rivers alone).
+    /// forms (unit-sphere area per model time; 2e-4 by default with the drainage model, 0: the rivers alone).
     pub network_diffusivity: f32,
     /// Relief `file` (beyond the thesis): the planet's heights as an equirectangular raster (TIFF, OpenEXR or
     /// 16-bit PNG; docs/planet.md, "Heights from a file"), the whole sphere or a region; in a file, relative to
