@@ -247,6 +247,15 @@ const float RIVER_JOIN_SPACING = 8.0;
 // river's.
 const float WIDTH_SLOPE_LIMIT = 0.25;
 
+// Whether a triangle's interpolated distance (screen derivatives `dd`) and half width `w` (`dw`) measure one river:
+// the distance changes at most RIVER_SLOPE_LIMIT and, on a triangle more than RIVER_FLAT_SPACING half widths
+// across, at least `slopeFloor` per unit of length, and the width at most WIDTH_SLOPE_LIMIT.
+bool measuresOneRiver(float w, vec2 dd, vec2 dw, vec3 px, vec3 py, float slopeFloor) {
+    float slope = distanceSlope(dd, px, py);
+    bool flatDistance = slope < slopeFloor && fSpacing > RIVER_FLAT_SPACING * w;
+    return slope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw, px, py) <= WIDTH_SLOPE_LIMIT;
+}
+
 // Beyond the thesis: RIVER_SLOPE_FLOOR for the river pair. Across a straight river the interpolated distance
 // changes by one unit per unit of length; where a triangle's vertices lie on either side of the line a river's
 // end points along (beyond a tributary's mouth or a source, the distance to the end's sample changes sign there)
@@ -261,12 +270,7 @@ const float PAIR_SLOPE_FLOOR = 0.8;
 // spacing is the mesh's in `auto`); -1 where not. `dd`, `dw`: the slot's screen derivatives.
 float pairBand(float d, float w, vec2 dd, vec2 dw, vec3 px, vec3 py, uint mode) {
     bool painted = mode == WATER_PAINTED || (mode == WATER_AUTO && fSpacing >= w);
-    float slope = distanceSlope(dd, px, py);
-    bool flatDistance = slope < PAIR_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * w;
-    if (!painted || w <= 0.0 || slope > RIVER_SLOPE_LIMIT || flatDistance
-        || distanceSlope(dw, px, py) > WIDTH_SLOPE_LIMIT) {
-        return -1.0;
-    }
+    if (!painted || w <= 0.0 || !measuresOneRiver(w, dd, dw, px, py, PAIR_SLOPE_FLOOR)) return -1.0;
     float e = abs(dd.x) + abs(dd.y) + 1e-4;
     return 1.0 - smoothBand(w - e, w + e, abs(d));
 }
@@ -323,9 +327,7 @@ void main() {
     float joinEdge = fwidth(fBank) + 1e-4;
     vec4 pairX = dFdx(fRiverPair);
     vec4 pairY = dFdy(fRiverPair);
-    float zSlope = distanceSlope(dz, px, py);
-    bool flatDistance = zSlope < RIVER_SLOPE_FLOOR && fSpacing > RIVER_FLAT_SPACING * fRiver.w;
-    bool measured = zSlope <= RIVER_SLOPE_LIMIT && !flatDistance && distanceSlope(dw, px, py) <= WIDTH_SLOPE_LIMIT;
+    bool measured = measuresOneRiver(fRiver.w, dz, dw, px, py, RIVER_SLOPE_FLOOR);
     vec3 normal = normalize(fNormal);
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).

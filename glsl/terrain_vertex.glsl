@@ -31,21 +31,24 @@ float baseAt(PatchInstance p, vec2 grid) {
     return textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
 }
 
-// River data at a grid position (layer 0: terrain height, lerp factor, water height, signed distance; layer 1: the
-// half width and the flow in the patch frame), blended by the morph factor into the parent's river data at the
-// same place.
-vec4 riverAt(PatchInstance p, vec2 grid, float morph, out vec3 widthFlow) {
+// One layer of the river data at a grid position, blended by the morph factor into the parent's river data at
+// the same place.
+vec4 riverLayerAt(PatchInstance p, vec2 grid, float morph, float layer) {
     float n = frame.planet.y;
-    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, 0.0);
-    vec4 river = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
-    widthFlow = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv + vec3(0, 0, 1), 0.0).rgb;
+    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, layer);
+    vec4 data = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
     if (morph > 0.0 && p.slots.w >= 0) {
-        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, 0.0);
-        river = mix(river, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
-        widthFlow = mix(widthFlow,
-                        textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv + vec3(0, 0, 1), 0.0).rgb, morph);
+        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, layer);
+        data = mix(data, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
     }
-    return river;
+    return data;
+}
+
+// River data at a grid position (layer 0: terrain height, lerp factor, water height, signed distance; layer 1: the
+// half width and the flow in the patch frame), blended as riverLayerAt blends.
+vec4 riverAt(PatchInstance p, vec2 grid, float morph, out vec3 widthFlow) {
+    widthFlow = riverLayerAt(p, grid, morph, 1.0).rgb;
+    return riverLayerAt(p, grid, morph, 0.0);
 }
 
 // The blended terrain height at a grid position (for normals).
@@ -67,16 +70,9 @@ const float BEYOND_END_WIDTH = 1e-3;
 // triangle between two rivers agree on which slot holds which; a slot no river fills is NO_RIVER, a river the
 // vertex lies beyond the end of has half width 0 (the kernel's negative half width), so that it narrows to
 // nothing there. From layer 2 of the river data (the second river, the nearest sample's half width, the order) and
-// the nearest distance, blended as riverAt blends; `beyondEnd`: whether the vertex lies beyond the nearest
-// river's end.
+// the nearest distance; `beyondEnd`: whether the vertex lies beyond the nearest river's end.
 vec4 riverPairAt(PatchInstance p, vec2 grid, float morph, float nearestDistance, out bool beyondEnd) {
-    float n = frame.planet.y;
-    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, 2.0);
-    vec4 second = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
-    if (morph > 0.0 && p.slots.w >= 0) {
-        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, 2.0);
-        second = mix(second, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
-    }
+    vec4 second = riverLayerAt(p, grid, morph, 2.0);
     beyondEnd = second.z < 0.0;
     vec2 nearest = second.z != 0.0 ? vec2(nearestDistance, max(second.z, 0.0)) : NO_RIVER;
     vec2 other = second.w != 0.0 ? vec2(second.x, max(second.y, 0.0)) : NO_RIVER;

@@ -147,16 +147,11 @@ pub struct Accumulators {
     pub in_river_sum: f32,
     /// Sum of `w_river`.
     pub in_river_w_sum: f32,
-    /// The signed distance to the nearest sample.
-    pub min_distance: f32,
-    /// The square of `min_distance`.
-    pub min_distance2: f32,
+    /// The nearest sample: its signed distance (Procedure 4's `minDistance`), the square of it, its half width
+    /// and, beyond the thesis, its river and how far along its flow the vertex lies.
+    pub nearest: NearestSample,
     /// The influence distance of the nearest sample: the lerp factor reaches 1 there.
     pub nearest_reach: f32,
-    /// The half width of the nearest sample.
-    pub nearest_half_width: f32,
-    /// Beyond the thesis: the nearest sample (again, with its river and how far along its flow the vertex lies).
-    pub nearest: NearestSample,
     /// Beyond the thesis: the nearest sample of another river than the nearest sample's.
     pub second: NearestSample,
     /// Beyond the thesis: the highest water level of the lake samples within half their width of the vertex
@@ -234,11 +229,8 @@ pub fn accumulate_height(
         in_river: false,
         in_river_sum: 0.0,
         in_river_w_sum: 0.0,
-        min_distance: f32::MAX,
-        min_distance2: f32::MAX,
-        nearest_reach: params.influence_distance,
-        nearest_half_width: 0.0,
         nearest: NearestSample::NONE,
+        nearest_reach: params.influence_distance,
         second: NearestSample::NONE,
         lake_level: -f32::MAX,
         lake_offset2: 1.0,
@@ -277,14 +269,11 @@ pub fn accumulate_height(
         }
         // Beyond the thesis: the nearest sample, and the nearest of another river (whose sample, nearer than
         // the second, becomes the second when another river's sample comes nearer still).
-        if c.dist2 < acc.min_distance2 {
+        if c.dist2 < acc.nearest.distance2 {
             if sample.river != acc.nearest.river {
                 acc.second = acc.nearest;
             }
-            acc.min_distance2 = c.dist2;
-            acc.min_distance = c.dist;
             acc.nearest_reach = c.reach;
-            acc.nearest_half_width = sample.width * 0.5;
             acc.nearest = NearestSample::of(&c, sample);
         } else if sample.river != acc.nearest.river && c.dist2 < acc.second.distance2 {
             acc.second = NearestSample::of(&c, sample);
@@ -365,7 +354,7 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
     // Beyond the thesis: a vertex nearest to a sample with its own, shorter reach (a finer level's stream) has
     // that stream's width, not the mean with the wide river whose valley it runs down.
     let river_width = if acc.nearest_reach < params.influence_distance {
-        acc.nearest_half_width
+        acc.nearest.half_width
     } else {
         acc.width_sum / acc.weight_sum
     };
@@ -381,7 +370,7 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
         let terrain_height = height + basin;
         let divisor = acc.nearest_reach - river_width;
         let lerp = if divisor > 0.0 {
-            ((acc.min_distance.abs() - river_width) / divisor).clamp(0.0, 1.0)
+            ((acc.nearest.distance.abs() - river_width) / divisor).clamp(0.0, 1.0)
         } else {
             0.0
         };
@@ -397,7 +386,7 @@ fn river_outputs(acc: &Accumulators, params: &KernelParams) -> RiverTexel {
         terrain_height,
         lerp_factor,
         water_height,
-        min_distance: acc.min_distance,
+        min_distance: acc.nearest.distance,
         river_width,
         flow: if acc.in_river {
             acc.flow_sum.map(|f| f / acc.in_river_w_sum)
