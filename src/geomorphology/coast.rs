@@ -51,18 +51,22 @@ impl LandMask {
             height,
             land: vec![false; width * height],
         };
-        // Only the rows measured are sampled.
+        // Only the rows measured are sampled; the sines and cosines of each column's longitude and each row's
+        // latitude are taken once (the same products as `direction_at`, so the same directions).
         let rows = mask.rows();
+        let angles = |degrees: f64| degrees.to_radians().sin_cos();
+        let columns: Vec<(f64, f64)> = (0..width)
+            .map(|x| angles(Self::lon_lat(width, x as f64 + 0.5, 0.0).0))
+            .collect();
         mask.land[rows.start * width..rows.end * width]
-            .par_iter_mut()
+            .par_chunks_mut(width)
             .enumerate()
-            .for_each(|(p, land)| {
-                let (x, y) = (
-                    (p % width) as f64 + 0.5,
-                    (p / width + rows.start) as f64 + 0.5,
-                );
-                let (lon, lat) = Self::lon_lat(width, x, y);
-                *land = is_land(direction_at(lon, lat));
+            .for_each(|(row, land)| {
+                let y = (row + rows.start) as f64 + 0.5;
+                let (sin_lat, cos_lat) = angles(Self::lon_lat(width, 0.0, y).1);
+                for (land, &(sin_lon, cos_lon)) in land.iter_mut().zip(&columns) {
+                    *land = is_land(DVec3::new(cos_lat * cos_lon, sin_lat, -cos_lat * sin_lon));
+                }
             });
         mask
     }

@@ -31,7 +31,9 @@ pub fn roughen(
     for (k, &(f, i, j)) in points.iter().enumerate() {
         node_land[grid.node(lattice, f, i, j) as usize] = land[k];
     }
-    let CoastDistances { to_sea, to_land } = CoastDistances::new(grid, &node_land);
+    // Far from the coast nothing can change: the distances are needed only near it.
+    let reach = 3.0 * AMPLITUDE;
+    let CoastDistances { to_sea, to_land } = CoastDistances::within(grid, &node_land, reach);
     let finest = 0.5 * grid.cells as f64 / std::f64::consts::FRAC_PI_2;
     points
         .par_iter()
@@ -41,8 +43,7 @@ pub fn roughen(
                 true => to_sea[node],
                 false => -to_land[node],
             };
-            // Far from the coast nothing can change.
-            if signed.abs() > 3.0 * AMPLITUDE {
+            if signed.abs() > reach {
                 return signed > 0.0;
             }
             let d = grid.directions[node];

@@ -185,8 +185,17 @@ fn evolve(
     let mut dt = FIRST_STEP;
     let mut time = 0.0;
     let mut report = ErosionReport::default();
+    let mut diffusion = (diffusivity > 0.0).then(|| Diffusion::new(grid, land, diffusivity));
     for step in 0..STEPS {
         let tree = ReceiverTree::new(grid, land, &h);
+        // Each node's erosion factor K dt A^m / L does not depend on the heights: taken side by side first.
+        let factor: Vec<f64> = (0..grid.len())
+            .into_par_iter()
+            .map(|k| match land[k] && tree.receiver[k] != k as u32 {
+                true => erodibility[k] * dt * tree.area[k].powf(AREA_EXPONENT) / tree.length[k],
+                false => 0.0,
+            })
+            .collect();
         let mut change: f64 = 0.0;
         // Downstream first, so each node's receiver already has its new height (implicit in the slope).
         for &k in &tree.downstream_first {
@@ -197,13 +206,13 @@ fn evolve(
                 h[k] += dt * uplift[k];
                 continue;
             }
-            let f = erodibility[k] * dt * tree.area[k].powf(AREA_EXPONENT) / tree.length[k];
+            let f = factor[k];
             let new = (h[k] + dt * uplift[k] + f * h[r as usize]) / (1.0 + f);
             change = change.max((new - h[k]).abs());
             h[k] = new;
         }
-        if time < NETWORK_FORMING_TIME && diffusivity > 0.0 {
-            h = diffuse(grid, land, h, diffusivity, dt);
+        if let Some(diffusion) = diffusion.as_mut().filter(|_| time < NETWORK_FORMING_TIME) {
+            diffusion.run(&mut h, dt);
         }
         time += dt;
         let highest = h.iter().copied().fold(0.0, f64::max).max(1e-12);
@@ -216,36 +225,63 @@ fn evolve(
     (h, report)
 }
 
-/// `h` after `dt` of linear diffusion `D lap h` on land (the sea stays the base level), in explicit substeps
-/// small enough to be stable. The Laplacian weighs each neighbour by one over its squared angle.
-fn diffuse(grid: &SphereGrid, land: &[bool], mut h: Vec<f64>, d: f64, dt: f64) -> Vec<f64> {
-    let stiffest = (0..grid.len() as u32)
-        .into_par_iter()
-        .map(|k| {
-            grid.steps(k)
-                .map(|(_, angle)| 1.0 / (angle * angle))
-                .sum::<f64>()
-        })
-        .reduce(|| 0.0, f64::max);
-    let substeps = (dt * d * stiffest / DIFFUSION_STABILITY).ceil().max(1.0);
-    let step = dt / substeps;
-    for _ in 0..substeps as usize {
-        h = (0..grid.len() as u32)
+/// Linear hillslope diffusion `D lap h` on land (the sea stays the base level), in explicit substeps small
+/// enough to be stable. The Laplacian weighs each neighbour by one over its squared angle.
+struct Diffusion<'a> {
+    grid: &'a SphereGrid,
+    land: &'a [bool],
+    diffusivity: f64,
+    /// The largest sum of a node's neighbour weights, which bounds the stable substep.
+    stiffest: f64,
+    /// The heights being written while the substep reads the others.
+    next: Vec<f64>,
+}
+
+impl<'a> Diffusion<'a> {
+    fn new(grid: &'a SphereGrid, land: &'a [bool], diffusivity: f64) -> Self {
+        let stiffest = (0..grid.len() as u32)
             .into_par_iter()
             .map(|k| {
-                let here = h[k as usize];
-                if !land[k as usize] {
-                    return here;
-                }
-                let laplacian: f64 = grid
-                    .steps(k)
-                    .map(|(next, angle)| (h[next as usize] - here) / (angle * angle))
-                    .sum();
-                here + step * d * laplacian
+                grid.steps(k)
+                    .map(|(_, angle)| 1.0 / (angle * angle))
+                    .sum::<f64>()
             })
-            .collect();
+            .reduce(|| 0.0, f64::max);
+        Self {
+            grid,
+            land,
+            diffusivity,
+            stiffest,
+            next: vec![0.0; grid.len()],
+        }
     }
-    h
+
+    /// Diffuses `h` over `dt`.
+    fn run(&mut self, h: &mut Vec<f64>, dt: f64) {
+        let d = self.diffusivity;
+        let substeps = (dt * d * self.stiffest / DIFFUSION_STABILITY)
+            .ceil()
+            .max(1.0);
+        let step = dt / substeps;
+        let (grid, land) = (self.grid, self.land);
+        for _ in 0..substeps as usize {
+            let here = &*h;
+            self.next.par_iter_mut().enumerate().for_each(|(k, next)| {
+                let at = here[k];
+                *next = match land[k] {
+                    true => {
+                        let laplacian: f64 = grid
+                            .steps(k as u32)
+                            .map(|(n, angle)| (here[n as usize] - at) / (angle * angle))
+                            .sum();
+                        at + step * d * laplacian
+                    }
+                    false => at,
+                };
+            });
+            std::mem::swap(h, &mut self.next);
+        }
+    }
 }
 
 /// Where the water of each land node goes in one step of the evolution (Braun and Willett 2013): its steepest
@@ -358,7 +394,8 @@ mod tests {
                 .map(|(k, n)| (h[k as usize] - h[n as usize]).abs())
                 .sum()
         };
-        let after = diffuse(&grid, &land, h.clone(), 1e-3, 50.0);
+        let mut after = h.clone();
+        Diffusion::new(&grid, &land, 1e-3).run(&mut after, 50.0);
         assert!(after.iter().all(|&x| (0.0..=1.0).contains(&x)));
         assert!((0..grid.len()).all(|k| land[k] || after[k] == 0.0));
         assert!(roughness(&after) < 0.2 * roughness(&h));

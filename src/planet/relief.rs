@@ -81,6 +81,12 @@ pub struct CoastDistances {
 impl CoastDistances {
     /// Both distances on `grid` for the nodes `land` marks, along the grid from the nodes beside the coast.
     pub fn new(grid: &SphereGrid, land: &[bool]) -> Self {
+        Self::within(grid, land, f64::INFINITY)
+    }
+
+    /// Both distances where they are at most `limit` (radians), `f64::INFINITY` beyond; the two searches run
+    /// side by side.
+    pub fn within(grid: &SphereGrid, land: &[bool], limit: f64) -> Self {
         let coast = |is_land: bool| -> Vec<u32> {
             (0..grid.len() as u32)
                 .filter(|&k| land[k as usize] != is_land)
@@ -91,9 +97,10 @@ impl CoastDistances {
                 })
                 .collect()
         };
-        Self {
-            to_sea: grid.nearest(&coast(true), f64::INFINITY).0,
-            to_land: grid.nearest(&coast(false), f64::INFINITY).0,
-        }
+        let (to_sea, to_land) = rayon::join(
+            || grid.nearest(&coast(true), limit).0,
+            || grid.nearest(&coast(false), limit).0,
+        );
+        Self { to_sea, to_land }
     }
 }
