@@ -116,12 +116,14 @@ pub fn drain_paths(
     let directions = |nodes: &[u32]| -> Vec<DVec3> {
         nodes.iter().map(|&k| grid.directions[k as usize]).collect()
     };
+    let base_levels = base_levels(&network, sea_level);
     let reaches: Vec<ReachPath> = network
         .reaches
         .iter()
-        .map(|reach| ReachPath {
+        .zip(&base_levels)
+        .map(|(reach, &base_level)| ReachPath {
             points: directions(&reach.nodes),
-            beds: beds(reach, &carved, &network, sea_level),
+            beds: beds(reach, &carved, &network, (sea_level, base_level)),
             areas: reach
                 .nodes
                 .iter()
@@ -189,13 +191,33 @@ pub fn width(river: &RiverConfig, largest_area: f64, area: f64) -> f32 {
     river.min_width + (widest - river.min_width) * share.clamp(0.0, 1.0)
 }
 
+/// The base level of each reach: the level of the water its river ends in, a lake's or the sea's. Reaches come
+/// upstream first, so each one's downstream reach is decided before it when taken in reverse.
+fn base_levels(network: &rivers::DrainageNetwork, sea_level: f64) -> Vec<f64> {
+    let mut levels = vec![sea_level; network.reaches.len()];
+    for (k, reach) in network.reaches.iter().enumerate().rev() {
+        levels[k] = match reach.downstream {
+            Some(d) => levels[d],
+            None => reach
+                .nodes
+                .last()
+                .and_then(|&end| network.lake_of[end as usize])
+                .map_or(sea_level, |lake| network.lakes[lake as usize].level),
+        };
+    }
+    levels
+}
+
 /// Bed heights along a reach: the carved terrain at its river nodes; at a mouth the sea level or the lake's level;
-/// never rising downstream.
+/// never rising downstream, and never below the `base_level` of the water the river ends in: where the valley
+/// carved into the eroded land lies below the level of the lake it runs into, the lake's water stands in it (a
+/// drowned mouth), and a river drawn below the lake's surface would pull the lake's water down beside it
+/// (tests/river_surface.rs).
 fn beds(
     reach: &rivers::Reach,
     carved: &[f64],
     network: &rivers::DrainageNetwork,
-    sea_level: f64,
+    (sea_level, base_level): (f64, f64),
 ) -> Vec<f32> {
     let mut out: Vec<f32> = Vec::with_capacity(reach.nodes.len());
     for &k in &reach.nodes {
@@ -205,7 +227,7 @@ fn beds(
             None if carved[k] <= sea_level => sea_level,
             None => carved[k],
         };
-        let h = h as f32;
+        let h = h.max(base_level) as f32;
         out.push(out.last().map_or(h, |&above: &f32| above.min(h)));
     }
     out

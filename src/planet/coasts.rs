@@ -2,9 +2,9 @@
 //! coast is moved in and out by fractal noise measured in distance from it, so coasts gain bays, peninsulas and
 //! islands at every scale instead of the Voronoi cells' straight edges, while continents' cores stay whole.
 //!
-//! The noise sums value-noise octaves from a few hundred kilometres on Earth down to two base cells, each twice
-//! as fine and `PERSISTENCE` as strong (a Hurst exponent H of 0.6): the level set of such a field has a
-//! box-counting dimension near 2 - H (Mandelbrot 1975; Voss 1985), and real coasts measure 1.15-1.4.
+//! The noise sums value-noise octaves from a few hundred kilometres on Earth down to the base lattice's own
+//! spacing, each twice as fine and `PERSISTENCE` as strong (a Hurst exponent H of 0.6): the level set of such a
+//! field has a box-counting dimension near 2 - H (Mandelbrot 1975; Voss 1985), and real coasts measure 1.15-1.4.
 
 use rayon::prelude::*;
 
@@ -34,7 +34,10 @@ pub fn roughen(
     // Far from the coast nothing can change: the distances are needed only near it.
     let reach = 3.0 * AMPLITUDE;
     let CoastDistances { to_sea, to_land } = CoastDistances::within(grid, &node_land, reach);
-    let finest = 0.5 * grid.cells as f64 / std::f64::consts::FRAC_PI_2;
+    // Octaves down to the lattice's own spacing (cells about 1.3 nodes wide), so the coast moves node by node and
+    // no stretch of it follows a lattice row or diagonal (which diamond-square draws as a straight line); octaves
+    // down to two cells left runs of up to 1.02 % of the circumference (docs/planet.md, "Fractal coasts").
+    let finest = grid.cells as f64 / std::f64::consts::FRAC_PI_2;
     points
         .par_iter()
         .map(|&(f, i, j)| {

@@ -48,7 +48,7 @@ pub fn river_error(spacing: f64, influence_distance: f64, widest: f64) -> f64 {
 /// Across a bend of curvature k the distance's second derivative at the inner bank is k / (1 - k w), and linear
 /// interpolation over a triangle misses by up to half of that times the square of its circumradius, s / sqrt 2 for
 /// the mesh's right triangles of legs s. The tightest bend is a meander's apex
-/// (`drainage::meanders::apex_curvature`, about 0.36 / w). At most the half width: a river drawn further aside
+/// (`drainage::meanders::apex_curvature`, about 0.41 / w). At most the half width: a river drawn further aside
 /// is at worst a river of its width drawn elsewhere.
 pub fn painted_bank_error(spacing: f64, half_width: f64) -> f64 {
     if half_width <= 0.0 || spacing < half_width {
