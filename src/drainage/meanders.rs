@@ -18,9 +18,10 @@ use super::ReachPath;
 pub const WAVELENGTH_WIDTHS: f64 = 11.0;
 /// The swing of the course's direction on a flat valley floor (radians): a sine-generated curve with this swing
 /// has a sinuosity of 1 / J0(1.45) = 1.85 (squeezed into the belt, less), a freely meandering lowland river's
-/// (Langbein and Leopold 1966 measure swings of 1-2 radians). With 1.25 (1.55) the median stream of seeds 1 and 3
-/// measured 1.23-1.25 when the coasts changed, at the foot of the 1.3-1.6 of real lowland rivers; 1.45 gives
-/// 1.32 / 1.37 / 1.32 on seeds 1-3 and 1.34-1.37 on seeds 4-6 (docs/rivers.md, "Meanders").
+/// (Langbein and Leopold 1966 measure swings of 1-2 radians). With 1.25 (1.55) seeds 1-3's median streams measured
+/// 1.25-1.28, at the foot of the 1.3-1.6 of real lowland rivers, and seed 1's 1.23 once the coasts gained their
+/// finest octave; 1.45 gives 1.32 / 1.37 / 1.32 on seeds 1-3 and 1.34-1.37 on seeds 4-6 (docs/rivers.md,
+/// "Meanders").
 const FLAT_SWING: f64 = 1.45;
 /// The valley slope (drop over run, as a share of the planet's relief over its radius) at which the swing has
 /// fallen to half of the flat one. The median order-3 reach of the default planet has 0.22. At 0.5 seed 3's median
