@@ -232,3 +232,46 @@ fn beds(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A river whose valley was cut below the level of the lake it runs into (nodes 2-4 below 2.0) has its beds
+    /// at the lake's level there, its tributary ends where it begins, and a river to the sea keeps its valley.
+    #[test]
+    fn beds_never_lie_below_the_lake_their_river_ends_in() {
+        let reach = |nodes: Vec<u32>, downstream| rivers::Reach {
+            nodes,
+            strahler: 1,
+            downstream,
+        };
+        let network = rivers::DrainageNetwork {
+            // Upstream first: the tributary, the stem into the lake (node 5), a river to the sea (node 8).
+            reaches: vec![
+                reach(vec![0, 1, 2], Some(1)),
+                reach(vec![2, 3, 4, 5], None),
+                reach(vec![6, 7, 8], None),
+            ],
+            lakes: vec![rivers::Lake {
+                nodes: vec![5],
+                level: 2.0,
+            }],
+            lake_of: (0..9).map(|k| (k == 5).then_some(0)).collect(),
+            measures: Default::default(),
+        };
+        let carved = [3.0, 2.5, 1.5, 1.2, 1.0, 0.5, 1.5, 0.8, 0.0];
+        let sea_level = 0.0;
+        let levels = base_levels(&network, sea_level);
+        assert_eq!(levels, vec![2.0, 2.0, 0.0]);
+        let beds: Vec<Vec<f32>> = network
+            .reaches
+            .iter()
+            .zip(&levels)
+            .map(|(r, &base)| beds(r, &carved, &network, (sea_level, base)))
+            .collect();
+        assert_eq!(beds[0], vec![3.0, 2.5, 2.0]);
+        assert_eq!(beds[1], vec![2.0, 2.0, 2.0, 2.0]);
+        assert_eq!(beds[2], vec![1.5, 0.8, 0.0]);
+    }
+}
