@@ -5,6 +5,7 @@
 // 32-bit hash, exact scalings, sorted four-value averages and `precise` arithmetic (no fused or reordered
 // operations). docs/planet.md explains the border, the folding across face edges and the cube corners.
 #extension GL_EXT_nonuniform_qualifier : require
+#include "slot_layers.glsl"
 layout(local_size_x = 64) in;
 
 layout(constant_id = 0) const int CELLS = 32;      // cells per patch edge (vertices - 1)
@@ -17,8 +18,8 @@ layout(set = 0, binding = 0, r32f) uniform writeonly image2DArray heightImages[]
 layout(set = 0, binding = 1) uniform sampler2DArray patchTextures[];
 
 struct RefineJob {
-    int childSlot;
-    int parentSlot;
+    int childPlace;  // the places of the child's and the parent's heights (slot_layers.glsl)
+    int parentPlace;
     int face;
     int level;      // the child's
     ivec2 patchXY;  // the child's position in its level's grid
@@ -119,7 +120,7 @@ float displaced(vec4 around, ivec2 g) {
 // A point of the parent's lattice (even child coordinates).
 float parentAt(ivec2 g) {
     ivec2 texel = g / 2 - parentOrigin + BORDER;
-    return texelFetch(patchTextures[nonuniformEXT(job.parentSlot)], ivec3(texel, 0), 0).r;
+    return texelFetch(patchTextures[nonuniformEXT(slotOf(job.parentPlace))], ivec3(texel, layerOf(job.parentPlace)), 0).r;
 }
 
 // A parent point or a diamond centre.
@@ -160,7 +161,7 @@ void main() {
                                valueAt(unfoldNeighbour(g, g + ivec2(0, -1))), valueAt(unfoldNeighbour(g, g + ivec2(0, 1))));
             value = displaced(around, g);
         }
-        imageStore(heightImages[nonuniformEXT(job.childSlot)], ivec3(texel, 0), vec4(value));
+        imageStore(heightImages[nonuniformEXT(slotOf(job.childPlace))], ivec3(texel, layerOf(job.childPlace)), vec4(value));
         range = vec2(min(range.x, value), max(range.y, value));
     }
 

@@ -10,7 +10,7 @@ void main() {
     uint index = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
     if (index >= size.x * size.y) return;
     uvec2 xy = uvec2(index % size.x, index / size.x);
-    if (job.parentSlot != NO_PARENT) {
+    if (job.parentPlace != NO_PARENT) {
         copyFromParent(job, xy);
         return;
     }

@@ -83,7 +83,7 @@ void main() {
     uvec2 xy = gl_WorkGroupID.xy * size + vertexInBlock(lane);
     // Invocations beyond the lattice take part in staging and in the subgroup broadcasts, and store nothing.
     bool hasVertex = all(lessThan(xy, latticeSize(job)));
-    if (job.parentSlot != NO_PARENT) {
+    if (job.parentPlace != NO_PARENT) {
         if (hasVertex) copyFromParent(job, xy);
         return;
     }

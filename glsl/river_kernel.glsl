@@ -1,6 +1,7 @@
 // The river-height kernel body (Procedures 3-5, Sections 6.5-6.6), shared by kernel_simple.comp (7.3.1) and
 // kernel_tiled.comp (7.3.2). Mirrors src/kernel/cpu.rs operation for operation; see docs/kernel.md.
 #extension GL_EXT_nonuniform_qualifier : require
+#include "slot_layers.glsl"
 
 // Position (xy) and first derivative (zw); height (x), full width (y) and, beyond the thesis, the sample's own
 // influence distance (z; 0: the kernel's, which bounds it) and its river's number (w).
@@ -9,7 +10,8 @@ struct RiverSample {
     vec4 heightWidth;
 };
 
-// One row of the dispatch: a patch's grid spacing, its range of samples, its bindless slot, where its reach
+// One row of the dispatch: a patch's grid spacing, its range of samples, its river texture's place (a slot and
+// layer: slot_layers.glsl), where its reach
 // masks start (in words; used by the tiled kernel only, see kernel_blocks.glsl), and which of its vertices the row
 // covers. A patch computed from scratch is one row over all its vertices. A patch that takes river data from its
 // parent (10.2, docs/kernel.md) is four rows, one per vertex parity: the even vertices copied from the parent's
@@ -18,12 +20,12 @@ struct PatchJob {
     float spacing;
     uint sampleOffset;
     uint sampleCount;
-    uint slot;
+    uint place;
     uint maskOffset;
     // Stride (bits 0-7) and the parity of the first vertex along x (bits 8-15) and y (16-23).
     uint lattice;
-    // The parent's slot to copy from, or NO_PARENT.
-    uint parentSlot;
+    // The place of the parent's river texture to copy from, or NO_PARENT.
+    uint parentPlace;
     // The parent vertex of the row's first vertex: x (bits 0-15), y (16-31).
     uint parentOffset;
 };
@@ -76,7 +78,9 @@ void copyFromParent(PatchJob job, uvec2 xy) {
     ivec2 from = ivec2(xy + uvec2(job.parentOffset & 0xffffu, job.parentOffset >> 16));
     ivec2 to = ivec2(patchVertex(job, xy));
     for (int layer = 0; layer < 3; ++layer) {
-        imageStore(riverImages[job.slot], ivec3(to, layer), imageLoad(riverImages[job.parentSlot], ivec3(from, layer)));
+        ivec3 target = ivec3(to, int(layerOf(job.place)) + layer);
+        ivec3 source = ivec3(from, int(layerOf(job.parentPlace)) + layer);
+        imageStore(riverImages[slotOf(job.place)], target, imageLoad(riverImages[slotOf(job.parentPlace)], source));
     }
 }
 
@@ -298,7 +302,9 @@ void storeHeight(Accumulators acc, PatchJob job, uvec2 xy) {
             second.zw = vec2(0.0);
         }
     }
-    imageStore(riverImages[job.slot], ivec3(xy, 0), heights);
-    imageStore(riverImages[job.slot], ivec3(xy, 1), vec4(riverWidth, flow, 0.0));
-    imageStore(riverImages[job.slot], ivec3(xy, 2), second);
+    uint slot = slotOf(job.place);
+    int layer = int(layerOf(job.place));
+    imageStore(riverImages[slot], ivec3(xy, layer), heights);
+    imageStore(riverImages[slot], ivec3(xy, layer + 1), vec4(riverWidth, flow, 0.0));
+    imageStore(riverImages[slot], ivec3(xy, layer + 2), second);
 }

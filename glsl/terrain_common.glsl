@@ -44,7 +44,8 @@ struct PatchInstance {
     vec4 axisU;       // xyz: cube-space step across the whole patch along i; w: 2 cubeCentre . axisU
     vec4 axisV;       // xyz: the same along j; w: 2 cubeCentre . axisV
     vec4 texRect;     // xy: source texel of vertex (0, 0); z: source texels per vertex; w: skirt length
-    ivec4 slots;      // x: base-height slot; y: river slot or -1; z: drawn quadrants; w: parent's river slot or -1
+    ivec4 slots;      // places (slot_layers.glsl) x: base heights; y: river data or -1; z: drawn quadrants (not a
+                      // place); w: the parent's river data or -1
     vec4 morph;       // x: share of the switch distance where morphing towards the parent starts; y: 1 / the
                       // morph band's share; zw: the patch's vertex (0, 0) in its parent's river texture
     vec4 switchDistances; // at the corners (0, 0), (n-1, 0), (0, n-1), (n-1, n-1); bilinear between them
@@ -77,5 +78,7 @@ layout(set = 1, binding = 0, std430) readonly buffer Instances { PatchInstance i
 // camera-relative position and 1 + morph factor.
 layout(set = 1, binding = 1, std430) writeonly buffer Captured { vec4 captured[]; };
 
-// Every patch texture is a 2D array view: base heights (1 layer, with a one-texel border), river data (2 layers).
+// Every patch texture is layers of a 2D array image (slot_layers.glsl): base heights (1 layer, with a border of two
+// texels), river data (3 layers).
+#include "slot_layers.glsl"
 layout(set = 0, binding = 1) uniform sampler2DArray patchTextures[];

@@ -7,9 +7,9 @@
 // Texture coordinates of a grid position in the base-height texture, which has a border of HEIGHT_BORDER points
 // (planet::detail::BORDER) on each side.
 const float HEIGHT_BORDER = 2.0;
-vec3 baseCoord(vec2 t) {
+vec2 baseCoord(vec2 t) {
     float n = frame.planet.y;
-    return vec3((t + 0.5 + HEIGHT_BORDER) / (n + 2.0 * HEIGHT_BORDER), 0.0);
+    return (t + 0.5 + HEIGHT_BORDER) / (n + 2.0 * HEIGHT_BORDER);
 }
 
 // The unit direction at a grid position minus the patch centre's, to f32 precision relative to the patch's size
@@ -28,18 +28,19 @@ vec3 directionOffset(PatchInstance p, vec2 grid) {
 
 float baseAt(PatchInstance p, vec2 grid) {
     vec2 t = p.texRect.xy + grid * p.texRect.z;
-    return textureLod(patchTextures[nonuniformEXT(p.slots.x)], baseCoord(t), 0.0).r;
+    int place = p.slots.x;
+    return textureLod(patchTextures[nonuniformEXT(slotOf(place))], vec3(baseCoord(t), layerOf(place)), 0.0).r;
 }
 
 // One layer of the river data at a grid position, blended by the morph factor into the parent's river data at
 // the same place.
 vec4 riverLayerAt(PatchInstance p, vec2 grid, float morph, float layer) {
     float n = frame.planet.y;
-    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, layer);
-    vec4 data = textureLod(patchTextures[nonuniformEXT(p.slots.y)], uv, 0.0);
+    vec3 uv = vec3((p.texRect.xy + grid * p.texRect.z + 0.5) / n, float(layerOf(p.slots.y)) + layer);
+    vec4 data = textureLod(patchTextures[nonuniformEXT(slotOf(p.slots.y))], uv, 0.0);
     if (morph > 0.0 && p.slots.w >= 0) {
-        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, layer);
-        data = mix(data, textureLod(patchTextures[nonuniformEXT(p.slots.w)], parentUv, 0.0), morph);
+        vec3 parentUv = vec3((p.morph.zw + grid * 0.5 + 0.5) / n, float(layerOf(p.slots.w)) + layer);
+        data = mix(data, textureLod(patchTextures[nonuniformEXT(slotOf(p.slots.w))], parentUv, 0.0), morph);
     }
     return data;
 }

@@ -6,10 +6,10 @@ use std::collections::HashMap;
 
 use crate::{
     gpu::{
-        bindless::{Bindless, Slot},
+        bindless::{Bindless, SlotLayer},
+        layers::{LayerKind, LayerPool},
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
-        Access, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc, MemoryLocation,
-        Recorder,
+        Access, BufferDesc, Context, Extent2D, Format, GpuError, Image, MemoryLocation, Recorder,
     },
     planet::{cube::PatchId, detail::PatchHeights, Planet},
     shader_types::{GpuRefineJob, RefinePush},
@@ -19,15 +19,15 @@ use crate::{
 /// Format of a patch's base-height texture: one f32 per lattice point, border included.
 pub const HEIGHT_FORMAT: Format = Format::R32_SFLOAT;
 
-/// A patch to refine: its id, the slot its fresh texture is bound at, and its parent's slot.
+/// A patch to refine: its id, the place of its fresh height texture, and its parent's.
 #[derive(Clone, Copy, Debug)]
 pub struct RefineJob {
     /// The patch.
     pub patch: PatchId,
-    /// Where its fresh height texture is bound.
-    pub slot: Slot,
-    /// Where its parent's is.
-    pub parent_slot: Slot,
+    /// Where its fresh height texture lies.
+    pub place: SlotLayer,
+    /// Where its parent's lies.
+    pub parent_place: SlotLayer,
 }
 
 /// A patch's lowest and highest base height.
@@ -98,17 +98,17 @@ impl HeightRefiner {
     }
 
     /// Records the refinement of `jobs`, sorted by level, each child's parent resident or earlier in the list:
-    /// one dispatch per level (a workgroup per patch), each declaring the parents' textures it samples
-    /// (`parent_texture` of a job), so that a child reads its parent's finished heights, uploaded or
-    /// refined a level before. The children's textures must be in GENERAL, bound at their slots; the caller
-    /// declares the results' next use. Returns where each child's height range arrives (read it once the
-    /// submission has completed), or `None` without jobs.
+    /// one dispatch per level (a workgroup per patch), each declaring the images of the parents' textures it
+    /// samples and of the children's it writes (`image` of a place; one image may hold both), so that a child
+    /// reads its parent's finished heights, uploaded or refined a level before. The caller declares the results'
+    /// next use. Returns where each child's height range arrives (read it once the submission has completed), or
+    /// `None` without jobs.
     pub fn record<'a>(
         &self,
         rec: &mut Recorder,
         (bindless, planet): (&Bindless, &Planet),
         jobs: &[RefineJob],
-        parent_texture: impl Fn(&RefineJob) -> Option<&'a Image>,
+        image: impl Fn(SlotLayer) -> Option<&'a Image>,
     ) -> Result<Option<RefinedRanges>, GpuError> {
         if jobs.is_empty() {
             return Ok(None);
@@ -120,8 +120,8 @@ impl HeightRefiner {
             .iter()
             .enumerate()
             .map(|(k, j)| GpuRefineJob {
-                child_slot: j.slot.0 as i32,
-                parent_slot: j.parent_slot.0 as i32,
+                child_place: j.place.shader_index() as i32,
+                parent_place: j.parent_place.shader_index() as i32,
                 face: j.patch.face as i32,
                 level: j.patch.level as i32,
                 x: j.patch.x as i32,
@@ -158,15 +158,24 @@ impl HeightRefiner {
                     .iter()
                     .take_while(|j| j.patch.level == level)
                     .count();
-            let parents = jobs[start..end]
-                .iter()
-                .map(|j| {
-                    parent_texture(j).ok_or_else(|| {
-                        GpuError::Invalid(format!("no texture for the parent of {:?}", j.patch))
-                    })
-                })
-                .collect::<Result<Vec<&Image>, GpuError>>()?;
-            rec.use_images(&parents, &[Access::ComputeSampled]);
+            let images_of = |place: fn(&RefineJob) -> SlotLayer, whose: &str| {
+                let mut images: Vec<&Image> = Vec::new();
+                for j in &jobs[start..end] {
+                    let found = image(place(j)).ok_or_else(|| {
+                        GpuError::Invalid(format!("no texture for the {whose} of {:?}", j.patch))
+                    })?;
+                    if !images.iter().any(|i| std::ptr::eq(*i, found)) {
+                        images.push(found);
+                    }
+                }
+                Ok::<_, GpuError>(images)
+            };
+            let parents = images_of(|j| j.parent_place, "parent")?;
+            let children = images_of(|j| j.place, "heights")?;
+            rec.use_images_reading_writing(
+                (&parents, Access::ComputeSampled),
+                (&children, Access::ComputeWrite),
+            );
             let mut buffer = rec.ctx().create_buffer(&BufferDesc {
                 name: "height refinement jobs",
                 size: ((end - start) * row) as u64,
@@ -193,31 +202,32 @@ impl HeightRefiner {
     }
 }
 
-/// Moves fresh base-height textures to GENERAL, ready for uploads and for the refinement shader's writes.
+/// Makes the images of new base-height textures ready for uploads and for the refinement shader's writes (in
+/// GENERAL, keeping the other layers).
 pub fn prepare_height_textures(rec: &mut Recorder, images: &[&Image]) {
-    rec.overwrite_images(images, &[Access::TransferWrite, Access::ComputeWrite]);
+    rec.use_images(images, &[Access::TransferWrite, Access::ComputeWrite]);
 }
 
-/// Creates one patch's base-height texture: `(n + 2 BORDER)^2` texels, written by upload (precomputed levels)
-/// or by the refinement shader, read by the terrain shaders and by the refinement of its children.
-pub fn create_height_texture(ctx: &Context, vertices: u32, name: &str) -> Result<Image, GpuError> {
+/// Patches' base-height textures as layers of array images: `(n + 2 BORDER)^2` texels each, written by upload
+/// (precomputed levels) or by the refinement shader, read by the terrain shaders and by the refinement of the
+/// children.
+pub fn height_textures(vertices: u32) -> LayerKind {
     let side = PatchHeights::side(vertices) as u32;
-    ctx.create_image(&ImageDesc {
-        name,
+    LayerKind {
+        name: "base heights",
         extent: Extent2D {
             width: side,
             height: side,
         },
-        layers: 1,
         format: HEIGHT_FORMAT,
+        layers_per_texture: 1,
         uses: &[
             Access::GraphicsSampled,
             Access::ComputeWrite,
             Access::TransferWrite,
             Access::TransferRead,
         ],
-        array: true,
-    })
+    }
 }
 
 /// The patches to make so that `wanted` can be refined: each with every ancestor finer than the precomputed
@@ -271,34 +281,19 @@ pub fn generate_on_gpu(
 ) -> Result<GpuPatches, GpuError> {
     let n = refiner.vertices;
     let all = with_ancestors(patches, planet.precomputed_level, |_| false);
-    let mut images: Vec<Image> = Vec::with_capacity(all.len());
-    let mut slots: HashMap<PatchId, Slot> = HashMap::new();
-    let release = |images: Vec<Image>, slots: HashMap<PatchId, Slot>, bindless: &mut Bindless| {
-        for s in slots.into_values() {
-            bindless.release(ctx, s);
-        }
-        drop(images);
-    };
+    let mut pool = LayerPool::new(height_textures(n), all.len())?;
+    let mut places: HashMap<PatchId, SlotLayer> = HashMap::new();
     for p in &all {
-        let Some(slot) = bindless.allocate(ctx) else {
-            let capacity = bindless.capacity;
-            release(images, slots, bindless);
-            return Err(GpuError::Invalid(format!(
-                "{} patches exceed the {capacity} bindless slots",
-                all.len()
-            )));
-        };
-        slots.insert(*p, slot);
-        match create_height_texture(ctx, n, &format!("base heights {p:?}")) {
-            Ok(image) => {
-                bindless.write(ctx, slot, &image, true);
-                images.push(image);
-            }
+        let place = pool.allocate(ctx, bindless).and_then(|place| {
+            place.ok_or_else(|| GpuError::Invalid(format!("no room for {} patches", all.len())))
+        });
+        match place {
+            Ok(place) => places.insert(*p, place),
             Err(e) => {
-                release(images, slots, bindless);
+                pool.release_slots(ctx, bindless);
                 return Err(e);
             }
-        }
+        };
     }
     let texel_bytes = (PatchHeights::side(n).pow(2) * 4) as u64;
     let readback = ctx.create_buffer(&BufferDesc {
@@ -310,48 +305,41 @@ pub fn generate_on_gpu(
     let readback = match readback {
         Ok(b) => b,
         Err(e) => {
-            release(images, slots, bindless);
+            pool.release_slots(ctx, bindless);
             return Err(e);
         }
     };
     let bindless_ref = &*bindless;
-    let slot_images: HashMap<Slot, &Image> = all
-        .iter()
-        .zip(&images)
-        .map(|(p, image)| (slots[p], image))
-        .collect();
+    let image = |place: SlotLayer| pool.image(place);
     let result = ctx.run_and_wait("height refinement", |rec| {
-        let refs: Vec<&Image> = images.iter().collect();
-        prepare_height_textures(rec, &refs);
+        let images = pool.images(places.values().copied());
+        prepare_height_textures(rec, &images);
         let mut jobs = Vec::new();
-        for (p, image) in all.iter().zip(&images) {
+        for p in &all {
+            let place = places[p];
             if p.level as u32 <= planet.precomputed_level {
                 let heights = planet.lattice.patch_heights(*p, n);
-                rec.upload_image_layer(image, 0, bytemuck::cast_slice(&heights.data))?;
+                let data = bytemuck::cast_slice(&heights.data);
+                rec.upload_image_layer(pool_image(image, place)?, place.layer, data)?;
             } else {
                 let parent = p.parent().expect("refined patches have parents");
                 jobs.push(RefineJob {
                     patch: *p,
-                    slot: slots[p],
-                    parent_slot: slots[&parent],
+                    place,
+                    parent_place: places[&parent],
                 });
             }
         }
-        let texture = |job: &RefineJob| slot_images.get(&job.parent_slot).copied();
-        let ranges = refiner.record(rec, (bindless_ref, planet), &jobs, texture)?;
-        let wanted: Vec<&Image> = patches
-            .iter()
-            .map(|p| {
-                let index = all
-                    .iter()
-                    .position(|q| q == p)
-                    .expect("every wanted patch is made");
-                &images[index]
-            })
-            .collect();
-        rec.use_images(&wanted, &[Access::TransferRead]);
-        for (k, image) in wanted.iter().enumerate() {
-            rec.copy_image_to_buffer(image, &readback, k as u64 * texel_bytes);
+        let ranges = refiner.record(rec, (bindless_ref, planet), &jobs, image)?;
+        let wanted: Vec<SlotLayer> = patches.iter().map(|p| places[p]).collect();
+        rec.use_images(
+            &pool.images(wanted.iter().copied()),
+            &[Access::TransferRead],
+        );
+        for (k, place) in wanted.iter().enumerate() {
+            let layers = place.layer..place.layer + 1;
+            let offset = k as u64 * texel_bytes;
+            rec.copy_layers_to_buffer(pool_image(image, *place)?, layers, &readback, offset);
         }
         rec.use_buffer(&readback, &[Access::HostRead]);
         Ok(ranges)
@@ -380,6 +368,14 @@ pub fn generate_on_gpu(
             .collect();
         Ok(GpuPatches { heights, ranges })
     });
-    release(images, slots, bindless);
+    pool.release_slots(ctx, bindless);
     out
+}
+
+/// The image `place` lies in, or an error naming it.
+fn pool_image<'a>(
+    image: impl Fn(SlotLayer) -> Option<&'a Image>,
+    place: SlotLayer,
+) -> Result<&'a Image, GpuError> {
+    image(place).ok_or_else(|| GpuError::Invalid(format!("no height texture at {place:?}")))
 }

@@ -79,14 +79,15 @@ pub struct GpuPatchJob {
     pub sample_offset: u32,
     /// Its samples.
     pub sample_count: u32,
-    /// The bindless slot of the patch's river texture.
-    pub slot: u32,
+    /// The place of the patch's river texture (`SlotLayer::shader_index`).
+    pub place: u32,
     /// Mask words of the rows before this one: the tiled kernel's reach masks of this row start there.
     pub mask_offset: u32,
     /// Stride (bits 0-7) and parity along x (bits 8-15) and y (bits 16-23) of the vertices this row covers.
     pub lattice: u32,
-    /// The parent's slot to copy the row's vertices from, or `kernel::gpu::jobs::NO_PARENT`.
-    pub parent_slot: u32,
+    /// The place of the parent's river texture to copy the row's vertices from, or
+    /// `kernel::gpu::jobs::NO_PARENT`.
+    pub parent_place: u32,
     /// The parent vertex of the row's first vertex: x (bits 0-15), y (bits 16-31).
     pub parent_offset: u32,
 }
@@ -140,10 +141,10 @@ const _: () = assert!(size_of::<TiledConstants>() == 20);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuRefineJob {
-    /// The bindless slot the child's heights go to.
-    pub child_slot: i32,
-    /// The bindless slot of the parent's heights.
-    pub parent_slot: i32,
+    /// The place the child's heights go to (`SlotLayer::shader_index`).
+    pub child_place: i32,
+    /// The place of the parent's heights.
+    pub parent_place: i32,
     /// The cube face.
     pub face: i32,
     /// The child's level.
@@ -214,7 +215,8 @@ pub struct PatchInstance {
     pub axis_v: [f32; 4],
     /// xy: the source texel of vertex (0, 0); z: source texels per vertex; w: skirt length.
     pub tex_rect: [f32; 4],
-    /// x: base-height slot; y: river slot or -1; z: drawn quadrants; w: the parent's river slot or -1.
+    /// Places (`SlotLayer::shader_index`) x: of the base heights; y: of the river data or -1; z: the drawn
+    /// quadrants (not a place); w: of the parent's river data or -1.
     pub slots: [i32; 4],
     /// x: where morphing starts (share of the switch distance); y: 1 / the morph band; zw: vertex (0, 0) in the
     /// parent's river texture.

@@ -4,6 +4,8 @@ mod common;
 
 use riverplanet::{
     gpu::{
+        bindless::{Bindless, SlotLayer},
+        layers::{LayerKind, LayerPool},
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
         Access, Buffer, BufferDesc, Context, Extent2D, Format, ImageDesc, MemoryLocation, Profiler,
         Recorder,
@@ -317,5 +319,95 @@ fn images_carry_their_last_use_from_barrier_to_barrier() {
     let read: &[f32] = bytemuck::cast_slice(readback.mapped().unwrap());
     assert_eq!(&read[..64], &texels(0.0)[..]);
     assert_eq!(&read[64..], &texels(1000.0)[..]);
+    common::assert_no_validation_errors(ctx);
+}
+
+/// Issue 37, item 4: textures of one kind are layers of a few array images. Each texture's layers are its own
+/// (written and read back apart from its neighbours'), every image but the last is full, a pool holds no more
+/// than its capacity, and a released place is handed out again once the GPU is done with it.
+#[test]
+fn textures_share_array_images_each_in_layers_of_its_own() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut bindless = Bindless::new(ctx, 8).unwrap();
+    let kind = LayerKind {
+        name: "test textures",
+        extent: Extent2D {
+            width: 4,
+            height: 4,
+        },
+        format: Format::R32_SFLOAT,
+        layers_per_texture: 3,
+        uses: &[
+            Access::TransferWrite,
+            Access::TransferRead,
+            Access::GraphicsSampled,
+        ],
+    };
+    let capacity = 200;
+    let mut pool = LayerPool::new(kind, capacity).unwrap();
+    let places: Vec<SlotLayer> = (0..capacity)
+        .map(|_| pool.allocate(ctx, &mut bindless).unwrap().unwrap())
+        .collect();
+    assert!(pool.allocate(ctx, &mut bindless).unwrap().is_none());
+    // 85 textures of 3 layers an image of 256 layers: three images.
+    assert_eq!(pool.image_count(), 3);
+    let mut distinct = places.clone();
+    distinct.sort_by_key(|p| p.shader_index());
+    distinct.dedup();
+    assert_eq!(distinct.len(), capacity);
+    assert!(places
+        .iter()
+        .all(|p| p.layer % 3 == 0 && p.layer + 3 <= 256));
+
+    let texels = |k: usize, layer: u32| -> Vec<f32> {
+        (0..16)
+            .map(|i| (k * 1000 + layer as usize * 100 + i) as f32)
+            .collect()
+    };
+    let bytes_each = 3 * 16 * 4;
+    let readback = ctx
+        .create_buffer(&BufferDesc {
+            name: "layer readback",
+            size: (capacity * bytes_each) as u64,
+            uses: &[Access::TransferWrite, Access::HostRead],
+            location: MemoryLocation::GpuToCpu,
+        })
+        .unwrap();
+    ctx.run_and_wait("layers written and read", |rec| {
+        let images = pool.images(places.iter().copied());
+        assert_eq!(images.len(), 3);
+        rec.use_images(&images, &[Access::TransferWrite]);
+        for (k, place) in places.iter().enumerate() {
+            for layer in 0..3 {
+                let data = texels(k, layer);
+                let image = pool.image(*place).unwrap();
+                rec.upload_image_layer(image, place.layer + layer, bytemuck::cast_slice(&data))?;
+            }
+        }
+        rec.use_images(&images, &[Access::TransferRead]);
+        for (k, place) in places.iter().enumerate() {
+            let layers = place.layer..place.layer + 3;
+            let offset = (k * bytes_each) as u64;
+            rec.copy_layers_to_buffer(pool.image(*place).unwrap(), layers, &readback, offset);
+        }
+        rec.use_buffer(&readback, &[Access::HostRead]);
+        Ok(())
+    })
+    .unwrap();
+    let read: &[f32] = bytemuck::cast_slice(readback.mapped().unwrap());
+    for k in 0..capacity {
+        let expected: Vec<f32> = (0..3).flat_map(|layer| texels(k, layer)).collect();
+        assert_eq!(&read[k * 48..(k + 1) * 48], &expected[..], "texture {k}");
+    }
+
+    // The GPU is done with everything submitted: a released place comes back.
+    pool.release(ctx, places[100]);
+    assert_eq!(pool.pending_release(), 1);
+    assert_eq!(
+        pool.allocate(ctx, &mut bindless).unwrap(),
+        Some(places[100])
+    );
+    assert_eq!(pool.image_count(), 3);
+    pool.release_slots(ctx, &mut bindless);
     common::assert_no_validation_errors(ctx);
 }

@@ -128,8 +128,8 @@ fn reuse_against_scratch(world: &World, parent: PatchId) -> (f32, f32) {
         )
         .unwrap()
     };
-    let parent_slot = parent_out.slots()[0];
-    let parents: Vec<_> = quadrants.iter().map(|q| Some((parent_slot, *q))).collect();
+    let parent_place = parent_out.places()[0];
+    let parents: Vec<_> = quadrants.iter().map(|q| Some((parent_place, *q))).collect();
     let parent_textures = parent_out.parent_textures(&parents);
     for variant in [KernelVariant::Simple, KernelVariant::Tiled] {
         let parent_gpu = run(variant, &parent_jobs, (&[], &[]), &parent_out).texels;

@@ -134,6 +134,13 @@ fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
             "frame {frame}: {} resident patches exceed the budget of 96",
             stats.resident_patches
         );
+        // Issue 37, item 4: the 96 patches and 64 spare textures of each kind are layers of one height image
+        // (256 layers) and two river images (85 patches each), reused as patches are evicted.
+        assert!(
+            stats.patch_texture_images <= 3,
+            "frame {frame}: the patch textures take {} array images",
+            stats.patch_texture_images
+        );
         assert!(
             stats.new_patches <= 16,
             "frame {frame}: {} new patches exceed the per-frame budget",
@@ -149,8 +156,8 @@ fn the_cache_never_exceeds_its_budget_over_a_long_flight() {
 }
 
 /// Issue 37: once warm, the frame loop creates no buffer or image. Staging, instance, vertex-cache and per-dispatch
-/// buffers come back from those earlier frames retired, and a new patch takes the textures of one the cache evicted
-/// (gpu/retire.rs). A context of its own: it counts what this flight creates.
+/// buffers come back from those earlier frames retired (gpu/retire.rs), and a new patch takes the texture layers of
+/// one the cache evicted (gpu/layers.rs). A context of its own: it counts what this flight creates.
 #[test]
 fn a_warm_frame_loop_creates_no_buffer_or_image() {
     let Some(own) = common::own_gpu() else { return };

@@ -168,7 +168,7 @@ pub fn reuse_bench(
     let (kernel, parent_out, child_out) = outputs?;
     let inherit: Vec<_> = children
         .iter()
-        .map(|(_, _, k, q)| Some((parent_out.slots()[*k], *q)))
+        .map(|(_, _, k, q)| Some((parent_out.places()[*k], *q)))
         .collect();
     let inherited = parent_out.parent_textures(&inherit);
     let mut gpu = |variant, from_parent: bool| -> Result<f64, GpuError> {

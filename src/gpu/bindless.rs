@@ -39,6 +39,34 @@ pub struct Bindless {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Slot(pub u32);
 
+/// Layers a [`SlotLayer`] can address in one slot's array image: the least `maxImageArrayLayers` Vulkan
+/// guarantees, so an array image of patch textures fits every device.
+pub const LAYERS_PER_SLOT: u32 = 256;
+
+/// Where a patch texture lies: an array image's slot and the first of the texture's layers in it. Shaders take
+/// it as one number, `slot * LAYERS_PER_SLOT + layer` (glsl/slot_layers.glsl); an image of its own is its slot's
+/// layer 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SlotLayer {
+    /// The array image's slot.
+    pub slot: Slot,
+    /// The texture's first layer in it (below [`LAYERS_PER_SLOT`]).
+    pub layer: u32,
+}
+
+impl SlotLayer {
+    /// The first layer of the image at `slot`: a texture with an image of its own.
+    pub fn whole(slot: Slot) -> Self {
+        Self { slot, layer: 0 }
+    }
+
+    /// The number shaders decode (glsl/slot_layers.glsl).
+    pub fn shader_index(self) -> u32 {
+        debug_assert!(self.layer < LAYERS_PER_SLOT);
+        self.slot.0 * LAYERS_PER_SLOT + self.layer
+    }
+}
+
 impl Bindless {
     /// Creates the set with `capacity` slots (clamped to the device's update-after-bind limits).
     pub fn new(ctx: &Context, capacity: u32) -> Result<Self, GpuError> {

@@ -81,9 +81,21 @@ impl Recorder<'_> {
     /// Copies the whole of `src` (in its layout for [`Access::TransferRead`]) into `dst` at `offset`, layer after
     /// layer, tightly packed (a transfer write of `dst`: [`Self::use_buffer`]).
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer, offset: u64) {
+        self.copy_layers_to_buffer(src, 0..src.layers, dst, offset);
+    }
+
+    /// Copies `layers` of `src` (in its layout for [`Access::TransferRead`]) into `dst` at `offset`, layer after
+    /// layer, tightly packed (a transfer write of `dst`: [`Self::use_buffer`]).
+    pub fn copy_layers_to_buffer(
+        &mut self,
+        src: &Image,
+        layers: std::ops::Range<u32>,
+        dst: &Buffer,
+        offset: u64,
+    ) {
         self.use_buffer(dst, &[Access::TransferWrite]);
         let layout = Access::TransferRead.layout(src.shader_visible());
-        let region = whole_layers(src, 0, src.layers, offset);
+        let region = whole_layers(src, layers.start, layers.len() as u32, offset);
         // SAFETY: the layout is the caller's contract (the barrier before); both objects outlive the submission.
         unsafe {
             self.ctx
@@ -142,15 +154,46 @@ impl Recorder<'_> {
         self.transition_images(images, uses, false);
     }
 
+    /// Declares one pass's uses: `read` of each of `reads`, `write` of each of `writes`, and both of an image in
+    /// both lists (an array image whose layers the pass reads in part and writes in part, as a refinement level
+    /// reads parents and writes children in one array), each image once and in one barrier.
+    pub fn use_images_reading_writing(
+        &mut self,
+        (reads, read): (&[&Image], Access),
+        (writes, write): (&[&Image], Access),
+    ) {
+        let mut declared: Vec<(&Image, Vec<Access>)> = Vec::new();
+        let all = reads
+            .iter()
+            .map(|i| (*i, read))
+            .chain(writes.iter().map(|i| (*i, write)));
+        for (image, access) in all {
+            match declared.iter_mut().find(|(i, _)| i.raw == image.raw) {
+                Some((_, uses)) if !uses.contains(&access) => uses.push(access),
+                Some(_) => {}
+                None => declared.push((image, vec![access])),
+            }
+        }
+        self.declare(declared.iter().map(|(i, uses)| (*i, &uses[..])), false);
+    }
+
     /// Makes each of `images` ready for `uses`, discarding its contents: an image about to be written whole.
     pub fn overwrite_images(&mut self, images: &[&Image], uses: &[Access]) {
         self.transition_images(images, uses, true);
     }
 
     fn transition_images(&mut self, images: &[&Image], uses: &[Access], discard: bool) {
-        let barriers: Vec<_> = images
-            .iter()
-            .filter_map(|image| {
+        self.declare(images.iter().map(|i| (*i, uses)), discard);
+    }
+
+    /// One barrier for each image's transition to its uses.
+    fn declare<'i>(
+        &mut self,
+        declared: impl Iterator<Item = (&'i Image, &'i [Access])>,
+        discard: bool,
+    ) {
+        let barriers: Vec<_> = declared
+            .filter_map(|(image, uses)| {
                 transition(
                     image.raw,
                     image.range(),

@@ -19,6 +19,7 @@ mod debug;
 pub mod features;
 pub mod frames;
 pub mod instance;
+pub mod layers;
 pub mod memory;
 pub mod overlay;
 pub mod pipeline;

@@ -1,10 +1,11 @@
 //! The kernel outside the renderer: one batch end to end (textures, upload, dispatch, read-back), for the tests
 //! and the kernel benchmarks.
 
-use super::{create_river_texture, KernelBatch, KernelVariant, RiverKernel, RIVER_TEXTURE_LAYERS};
+use super::{river_textures, KernelBatch, KernelVariant, RiverKernel, RIVER_TEXTURE_LAYERS};
 use crate::{
     gpu::{
-        bindless::{Bindless, Slot},
+        bindless::{Bindless, SlotLayer},
+        layers::LayerPool,
         Access, Buffer, BufferDesc, Context, GpuError, Image, MemoryLocation, Profiler,
         ScopeTiming,
     },
@@ -49,12 +50,13 @@ pub struct BatchResult {
     pub temporary_bytes: u64,
 }
 
-/// The output side of a batch: a river texture per patch, each in its bindless slot, and a host-visible buffer
-/// the textures are copied to. Benchmarks keep one between repetitions, as the renderer keeps its textures
-/// resident, so that repetitions measure the work and not the driver's first touch of fresh memory.
+/// The output side of a batch: a river texture per patch, as layers of array images (the renderer's
+/// [`LayerPool`]), and a host-visible buffer the textures are copied to. Benchmarks keep one between repetitions,
+/// as the renderer keeps its textures resident, so that repetitions measure the work and not the driver's first
+/// touch of fresh memory.
 pub struct BatchOutputs {
-    images: Vec<Image>,
-    slots: Vec<Slot>,
+    pool: LayerPool,
+    places: Vec<SlotLayer>,
     readback: Buffer,
     grid_size: u32,
 }
@@ -73,48 +75,40 @@ impl BatchOutputs {
             uses: &[Access::TransferWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })?;
-        let mut outputs = Self {
-            images: Vec::with_capacity(patches),
-            slots: Vec::with_capacity(patches),
-            readback,
-            grid_size,
-        };
-        for k in 0..patches {
-            let Some(slot) = bindless.allocate(ctx) else {
-                let capacity = bindless.capacity;
-                outputs.release(ctx, bindless);
-                return Err(GpuError::Invalid(format!(
-                    "batch of {patches} patches exceeds the {capacity} bindless slots"
-                )));
-            };
-            outputs.slots.push(slot);
-            let image = match create_river_texture(ctx, grid_size, &format!("river texture {k}")) {
-                Ok(image) => image,
+        let mut pool = LayerPool::new(river_textures(grid_size), patches)?;
+        let mut places = Vec::with_capacity(patches);
+        while places.len() < patches {
+            let place = pool.allocate(ctx, bindless).and_then(|place| {
+                place.ok_or_else(|| {
+                    GpuError::Invalid(format!("no room for {patches} river textures"))
+                })
+            });
+            match place {
+                Ok(place) => places.push(place),
                 Err(e) => {
-                    outputs.release(ctx, bindless);
+                    pool.release_slots(ctx, bindless);
                     return Err(e);
                 }
-            };
-            bindless.write(ctx, slot, &image, true);
-            outputs.images.push(image);
+            }
         }
-        Ok(outputs)
+        Ok(Self {
+            pool,
+            places,
+            readback,
+            grid_size,
+        })
     }
 
-    /// The bindless slots of the textures, in order.
-    pub fn slots(&self) -> &[Slot] {
-        &self.slots
+    /// The places of the textures, in order.
+    pub fn places(&self) -> &[SlotLayer] {
+        &self.places
     }
 
-    /// The textures that `parents` (as in [`KernelBatch`]) name by their slots, each once: what a batch reading
+    /// The images that `parents` (as in [`KernelBatch`]) name by their places, each once: what a batch reading
     /// these outputs as its parents declares it reads.
-    pub fn parent_textures(&self, parents: &[Option<(Slot, ParentQuadrant)>]) -> Vec<&Image> {
-        self.images
-            .iter()
-            .zip(&self.slots)
-            .filter(|(_, slot)| parents.iter().flatten().any(|(s, _)| s == *slot))
-            .map(|(image, _)| image)
-            .collect()
+    pub fn parent_textures(&self, parents: &[Option<(SlotLayer, ParentQuadrant)>]) -> Vec<&Image> {
+        self.pool
+            .images(parents.iter().flatten().map(|(place, _)| *place))
     }
 
     /// Bytes of one patch's layers, tightly packed.
@@ -122,12 +116,10 @@ impl BatchOutputs {
         (grid_size * grid_size * 16 * RIVER_TEXTURE_LAYERS) as u64
     }
 
-    /// Frees the textures' slots; the textures and the read-back buffer are retired as `self` drops (freed once
+    /// Frees the images' slots; the images and the read-back buffer are retired as `self` drops (freed once
     /// the GPU is done with them).
     pub fn release(self, ctx: &Context, bindless: &mut Bindless) {
-        for s in self.slots {
-            bindless.release(ctx, s);
-        }
+        self.pool.release_slots(ctx, bindless);
     }
 }
 
@@ -156,9 +148,9 @@ pub fn run_batch(
     result
 }
 
-/// Where a batch's patches take their parents' river data: per job, the parent's slot and quadrant, and the
-/// textures those slots hold (as in [`KernelBatch`]).
-pub type Parents<'a> = (&'a [Option<(Slot, ParentQuadrant)>], &'a [&'a Image]);
+/// Where a batch's patches take their parents' river data: per job, the parent's river texture and quadrant, and
+/// the images those lie in (as in [`KernelBatch`]).
+pub type Parents<'a> = (&'a [Option<(SlotLayer, ParentQuadrant)>], &'a [&'a Image]);
 
 /// [`run_batch`] into existing outputs (at least one texture per job): upload, dispatch, readback, decode.
 /// `parents` and the textures they name as in [`KernelBatch`] ([`BatchOutputs::parent_textures`]).
@@ -174,25 +166,24 @@ pub fn run_batch_into(
     outputs: &BatchOutputs,
 ) -> Result<BatchResult, GpuError> {
     let n = kernel.grid_size;
-    if outputs.images.len() < jobs.len() || outputs.grid_size != n {
+    if outputs.places.len() < jobs.len() || outputs.grid_size != n {
         return Err(GpuError::Invalid(format!(
             "batch of {} patches of {n}x{n} vertices does not fit outputs for {} patches of {}x{}",
             jobs.len(),
-            outputs.images.len(),
+            outputs.places.len(),
             outputs.grid_size,
             outputs.grid_size
         )));
     }
     let texel_bytes = BatchOutputs::texel_bytes(n);
-    let images = &outputs.images[..jobs.len()];
-    let slots = &outputs.slots[..jobs.len()];
+    let places = &outputs.places[..jobs.len()];
     let readback = &outputs.readback;
     let mut profiler = Profiler::new(ctx, 2, "river kernel timestamps")?;
-    let image_refs: Vec<&Image> = images.iter().collect();
+    let image_refs = outputs.pool.images(places.iter().copied());
     let result = ctx.run_and_wait("river kernel batch", |rec| {
         let batch = KernelBatch {
             textures: &image_refs,
-            slots,
+            places,
             jobs,
             parents,
             parent_textures,
@@ -201,8 +192,12 @@ pub fn run_batch_into(
             kernel.record(rec, bindless, variant, &batch, params)
         })??;
         rec.use_images(&image_refs, &[Access::TransferRead]);
-        for (k, image) in images.iter().enumerate() {
-            rec.copy_image_to_buffer(image, readback, k as u64 * texel_bytes);
+        for (k, place) in places.iter().enumerate() {
+            let image = outputs.pool.image(*place).ok_or_else(|| {
+                GpuError::Invalid(format!("{place:?} lies in none of the outputs' images"))
+            })?;
+            let layers = place.layer..place.layer + RIVER_TEXTURE_LAYERS;
+            rec.copy_layers_to_buffer(image, layers, readback, k as u64 * texel_bytes);
         }
         rec.use_buffer(readback, &[Access::HostRead]);
         Ok(bytes)

@@ -1,10 +1,10 @@
 //! The range table of a dispatch (std430 rows the kernels read, glsl/river_kernel.glsl): which samples, output
-//! slot, reach masks and vertex lattice each row covers.
+//! texture's place, reach masks and vertex lattice each row covers.
 
 use super::KernelBatch;
 pub use crate::shader_types::GpuPatchJob;
 
-/// `parent_slot` of a row computed by the kernel.
+/// `parent_place` of a row computed by the kernel.
 pub const NO_PARENT: u32 = u32::MAX;
 
 impl GpuPatchJob {
@@ -43,18 +43,18 @@ pub fn range_table(batch: &KernelBatch, n: u32, block: [u32; 2]) -> RangeTable {
         offset += job.samples.len() as u32;
     }
     let parent = |k: usize| batch.parents.get(k).copied().flatten();
-    let row = |k: usize, lattice: u32, parent_slot: u32, parent_offset: u32| GpuPatchJob {
+    let row = |k: usize, lattice: u32, parent_place: u32, parent_offset: u32| GpuPatchJob {
         spacing: batch.jobs[k].spacing,
         sample_offset: sample_offsets[k],
-        sample_count: if parent_slot == NO_PARENT {
+        sample_count: if parent_place == NO_PARENT {
             batch.jobs[k].samples.len() as u32
         } else {
             0
         },
-        slot: batch.slots[k].0,
+        place: batch.places[k].shader_index(),
         mask_offset: 0,
         lattice,
-        parent_slot,
+        parent_place,
         parent_offset,
     };
     let mut rows: Vec<GpuPatchJob> = (0..batch.jobs.len())
@@ -63,9 +63,9 @@ pub fn range_table(batch: &KernelBatch, n: u32, block: [u32; 2]) -> RangeTable {
         .collect();
     let full_rows = rows.len();
     for k in 0..batch.jobs.len() {
-        if let Some((slot, quadrant)) = parent(k) {
+        if let Some((place, quadrant)) = parent(k) {
             let [x, y] = quadrant.offset;
-            rows.push(row(k, 2, slot.0, x | y << 16));
+            rows.push(row(k, 2, place.shader_index(), x | y << 16));
             for parity in [[1, 0], [0, 1], [1, 1]] {
                 rows.push(row(k, 2 | parity[0] << 8 | parity[1] << 16, NO_PARENT, 0));
             }

@@ -1,7 +1,7 @@
 //! The GPU river kernel (Chapter 7): the simple (7.3.1) and tiled (7.3.2) compute shaders, and the recording of
 //! the dispatch that computes every new patch of a frame. A range table (one [`GpuPatchJob`] per patch, four for a
 //! patch that takes river data from its parent) maps the workgroups' row index to the sample range, the output
-//! slot and the vertices of the row.
+//! texture's place and the vertices of the row.
 
 pub mod autotune;
 mod batch;
@@ -16,10 +16,11 @@ pub use self::{
 use super::{KernelParams, ParentQuadrant, PatchJob, RiverSample};
 use crate::{
     gpu::{
-        bindless::{Bindless, Slot},
+        bindless::{Bindless, SlotLayer},
+        layers::LayerKind,
         pipeline::{BufferSetLayout, ComputeDesc, ComputePipeline},
-        Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, Image, ImageDesc,
-        MemoryLocation, Recorder,
+        Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, Image, MemoryLocation,
+        Recorder,
     },
     shader_types::{KernelPush, TiledConstants},
     shaders,
@@ -41,20 +42,22 @@ pub const RIVER_TEXTURE_FORMAT: Format = Format::R32G32B32A32_SFLOAT;
 /// See `RIVER_TEXTURE_FORMAT`.
 pub const RIVER_TEXTURE_LAYERS: u32 = 3;
 
-/// One dispatch's input: per job (patch), its fresh river texture, the bindless slot of that texture, and its
-/// spacing and samples; and for jobs that take their even vertices from their parent (10.2), the parent's slot
-/// (its river texture in the GENERAL layout) and quadrant. `parents` is empty or as long as `jobs`.
+/// One dispatch's input: per job (patch), the place of its river texture (a slot and layers), and its spacing and
+/// samples; and for jobs that take their even vertices from their parent (10.2), the place of the parent's river
+/// texture (in the GENERAL layout) and the quadrant. `parents` is empty or as long as `jobs`.
 #[derive(Clone, Copy)]
 pub struct KernelBatch<'a> {
-    /// Per job, the river texture it writes.
+    /// The images the jobs' places lie in, each once: the dispatch writes them (their other layers keep their
+    /// contents).
     pub textures: &'a [&'a Image],
-    /// Per job, that texture's bindless slot.
-    pub slots: &'a [Slot],
+    /// Per job, the place of its river texture.
+    pub places: &'a [SlotLayer],
     /// The patches, with their vertex spacing and samples.
     pub jobs: &'a [PatchJob<'a>],
-    /// Per job, its parent's slot and the quadrant it covers of it, where it takes its even vertices from there.
-    pub parents: &'a [Option<(Slot, ParentQuadrant)>],
-    /// The river textures those parents' slots hold (each once): the dispatch reads them.
+    /// Per job, its parent's river texture and the quadrant it covers of it, where it takes its even vertices
+    /// from there.
+    pub parents: &'a [Option<(SlotLayer, ParentQuadrant)>],
+    /// The images those parents' places lie in (each once): the dispatch reads them.
     pub parent_textures: &'a [&'a Image],
 }
 
@@ -141,8 +144,8 @@ impl RiverKernel {
         })
     }
 
-    /// Records one dispatch computing every job of `batch` into its slot's river texture. The textures are fresh
-    /// (any layout): they are moved to GENERAL here. The sample and range-table buffers are host-visible
+    /// Records one dispatch computing every job of `batch` into its river texture's layers. The images are moved
+    /// to GENERAL here, keeping their other layers. The sample and range-table buffers are host-visible
     /// per-dispatch buffers, freed when the submission completes. Returns their size in bytes (the frame's
     /// temporary sample memory). The caller makes the results visible to whatever reads them next.
     pub fn record(
@@ -153,12 +156,15 @@ impl RiverKernel {
         batch: &KernelBatch,
         params: &KernelParams,
     ) -> Result<u64, GpuError> {
-        rec.overwrite_images(batch.textures, &[Access::ComputeWrite]);
         if batch.jobs.is_empty() {
             return Ok(0);
         }
-        // The parents' river textures were written by an earlier dispatch.
-        rec.use_images(batch.parent_textures, &[Access::ComputeRead]);
+        // The parents' river textures were written by an earlier dispatch; they may share an image with the
+        // textures written now.
+        rec.use_images_reading_writing(
+            (batch.parent_textures, Access::ComputeRead),
+            (batch.textures, Access::ComputeWrite),
+        );
         let ctx = rec.ctx();
         let host_buffer = |name: &str, size: usize| {
             ctx.create_buffer(&BufferDesc {
@@ -274,21 +280,21 @@ impl RiverKernel {
     }
 }
 
-/// Creates one patch's river texture.
-pub fn create_river_texture(ctx: &Context, grid_size: u32, name: &str) -> Result<Image, GpuError> {
-    ctx.create_image(&ImageDesc {
-        name,
+/// Patches' river textures as layers of array images: written by the kernel, read by the terrain's shaders and
+/// by children's kernel rows, copied out by tests and benchmarks.
+pub fn river_textures(grid_size: u32) -> LayerKind {
+    LayerKind {
+        name: "river data",
         extent: Extent2D {
             width: grid_size,
             height: grid_size,
         },
-        layers: RIVER_TEXTURE_LAYERS,
         format: RIVER_TEXTURE_FORMAT,
+        layers_per_texture: RIVER_TEXTURE_LAYERS,
         uses: &[
             Access::ComputeWrite,
             Access::GraphicsSampled,
             Access::TransferRead,
         ],
-        array: true,
-    })
+    }
 }

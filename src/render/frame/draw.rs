@@ -197,8 +197,8 @@ impl Renderer<'_> {
                 (true, Some(parent)) if self.morphing => self
                     .cache
                     .touch(&parent)
-                    .and_then(|d| d.river.as_ref())
-                    .map_or(-1, |(_, slot)| slot.0 as i32),
+                    .and_then(|d| d.river)
+                    .map_or(-1, |place| place.shader_index() as i32),
                 _ => -1,
             };
             let Some(data) = self.cache.touch(&source) else {

@@ -23,14 +23,14 @@ pub use self::draw::{DrawnVertex, VertexCapture};
 pub use self::inflight::GpuTimes;
 use self::inflight::{InFlight, TIMESTAMP_SCOPES};
 pub use self::modes::{ViewMode, WaterMode};
-use self::resident::PatchData;
+use self::resident::{PatchData, PatchTextures, TextureKind};
 pub use self::stats::FrameStats;
 use super::mesh::{index_buffer, patch_mesh, PatchMesh, QuadrantMesh};
 use crate::shader_types::FramePush;
 use crate::{
     config::{Config, LodRule},
     gpu::{
-        bindless::{Bindless, Slot},
+        bindless::{Bindless, SlotLayer},
         frames::{FrameRing, FRAMES_IN_FLIGHT},
         pipeline::{Blend, BufferSetLayout, GraphicsDesc, GraphicsPipeline, RenderTarget},
         Access, Buffer, BufferDesc, Context, Extent2D, Format, GpuError, MemoryLocation, Semaphore,
@@ -63,6 +63,9 @@ pub type Overlay<'a> = &'a mut dyn FnMut(&mut crate::gpu::Recorder, Extent2D);
 /// other planets scale the bands by their own mountain height.
 const COLOUR_BAND_MOUNTAIN_HEIGHT: f32 = 16.0;
 
+/// Textures of each kind beyond the resident patches': the frame's new patches before the cache evicts.
+const SPARE_TEXTURES: usize = 64;
+
 /// Bytes of the largest resident patch: its base-height texture and a river texture.
 fn max_patch_bytes(n: u32) -> usize {
     let side = crate::planet::detail::PatchHeights::side(n);
@@ -92,6 +95,8 @@ pub struct Renderer<'w> {
     network: &'w RiverNetwork,
     config: Config,
     bindless: Bindless,
+    /// The resident patches' textures, layers of a few array images per kind.
+    textures: PatchTextures,
     kernel: RiverKernel,
     refiner: HeightRefiner,
     terrain: GraphicsPipeline,
@@ -198,9 +203,13 @@ impl<'w> Renderer<'w> {
         let memory = config.rendering.resident_memory_mb as usize * 1024 * 1024;
         let capacity =
             (config.rendering.max_resident_patches as usize).min(memory / max_patch_bytes(n));
-        let mut bindless = Bindless::new(ctx, (2 * capacity + 64) as u32)?;
-        // Two slots per patch at most; keep the cache within what the bindless arrays hold.
-        let capacity = capacity.min((bindless.capacity as usize - 64) / 2);
+        // Room for the resident patches and the new ones of a frame; a few more slots for the atmosphere's
+        // table and the lake map.
+        let textures = PatchTextures::new(n, capacity + SPARE_TEXTURES)?;
+        let mut bindless = Bindless::new(
+            ctx,
+            (PatchTextures::slots_for(capacity + SPARE_TEXTURES) + 16) as u32,
+        )?;
         // The shape and variant measured on this device at first use (cached per device and driver).
         let tuned = autotune::tuned(ctx, n)?;
         let kernel = RiverKernel::new(ctx, &bindless, n, tuned.tuning)?;
@@ -336,6 +345,7 @@ impl<'w> Renderer<'w> {
             network,
             config: config.clone(),
             bindless,
+            textures,
             kernel,
             refiner,
             terrain,
@@ -496,7 +506,13 @@ impl<'w> Renderer<'w> {
         stats.frames_in_flight = self.frames.in_flight(ctx)?;
         self.report_latest_gpu_times(&mut stats);
         stats.resident_patches = self.cache.len();
-        stats.patch_texture_bytes = self.cache.values().map(PatchData::bytes).sum();
+        stats.patch_texture_bytes = self
+            .cache
+            .values()
+            .map(|data| data.bytes(&self.textures))
+            .sum();
+        stats.patch_texture_images =
+            self.textures.heights.image_count() + self.textures.rivers.image_count();
         stats.precomputed_height_bytes = self.planet.lattice.bytes();
         stats.memory_bytes = stats.patch_texture_bytes
             + stats.temporary_sample_bytes
@@ -529,37 +545,39 @@ impl<'w> Renderer<'w> {
         self.kernel_observer = Some(observer);
     }
 
-    /// Evicts the least recently used patches beyond `target` (`PatchCache::evict_to`) and frees their slots;
-    /// returns how many.
+    /// Evicts the least recently used patches beyond `target` (`PatchCache::evict_to`) and frees their
+    /// textures' layers; returns how many.
     fn evict_patches(&mut self, target: usize) -> usize {
         let evicted = self.cache.evict_to(target);
         let count = evicted.len();
         for data in evicted {
-            data.release(self.ctx, &mut self.bindless);
+            data.release(self.ctx, &mut self.textures);
         }
         count
     }
 
-    /// A free bindless slot, evicting the least recently used patches if none is left, and waiting for the frames
-    /// in flight when the evicted slots are still theirs (only when the cache is full).
-    fn slot(&mut self) -> Result<Slot, GpuError> {
+    /// A free place for a texture of `kind`, evicting the least recently used patches if none is left, and
+    /// waiting for the frames in flight when the evicted places are still theirs (only when the cache is full).
+    fn texture_place(&mut self, kind: TextureKind) -> Result<SlotLayer, GpuError> {
         let ctx = self.ctx;
-        if let Some(s) = self.bindless.allocate(ctx) {
-            return Ok(s);
+        if let Some(place) = self.textures.allocate(ctx, &mut self.bindless, kind)? {
+            return Ok(place);
         }
         self.evict_patches(self.cache.capacity);
-        if let Some(s) = self.bindless.allocate(ctx) {
-            return Ok(s);
+        if let Some(place) = self.textures.allocate(ctx, &mut self.bindless, kind)? {
+            return Ok(place);
         }
-        if self.bindless.pending_release() > 0 {
+        if self.textures.pending_release() > 0 {
             let finished = self.frames.drain(ctx)?;
             self.collect(finished)?;
         }
-        self.bindless.allocate(ctx).ok_or_else(|| {
-            GpuError::Invalid(format!(
-                "all {} bindless slots are in use; raise max-resident-patches or lower new-patches-per-frame",
-                self.bindless.capacity
-            ))
-        })
+        self.textures
+            .allocate(ctx, &mut self.bindless, kind)?
+            .ok_or_else(|| {
+                GpuError::Invalid(format!(
+                    "all {} patch textures are in use; raise max-resident-patches or lower new-patches-per-frame",
+                    self.cache.capacity + SPARE_TEXTURES
+                ))
+            })
     }
 }

@@ -108,8 +108,8 @@ pub(super) fn instance(
         axis_v: with(axis_v, 2.0 * cube_centre.dot(axis_v)),
         tex_rect: [offset_x, offset_y, scale, 0.0],
         slots: [
-            data.base_slot.0 as i32,
-            data.river.as_ref().map_or(-1, |(_, s)| s.0 as i32),
+            data.base.shader_index() as i32,
+            data.river.map_or(-1, |place| place.shader_index() as i32),
             selected.quadrants as i32,
             -1,
         ],

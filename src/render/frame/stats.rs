@@ -35,6 +35,8 @@ pub struct FrameStats {
     pub evicted_patches: usize,
     /// Bytes of resident patch textures.
     pub patch_texture_bytes: u64,
+    /// Array images the patch textures lie in, both kinds (each image holds many patches' layers).
+    pub patch_texture_images: usize,
     /// Bytes of this frame's sample buffers.
     pub temporary_sample_bytes: u64,
     /// Bytes of the precomputed lattice.

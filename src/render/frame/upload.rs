@@ -6,15 +6,15 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use super::{resident::PatchData, Renderer};
+use super::{
+    resident::{PatchData, TextureKind},
+    Renderer,
+};
 use crate::{
-    gpu::{bindless::Slot, Access, GpuError, Image, Recorder},
-    kernel::{
-        gpu::{create_river_texture, KernelBatch},
-        ParentQuadrant, PatchJob, RiverSample,
-    },
+    gpu::{bindless::SlotLayer, Access, GpuError, Recorder},
+    kernel::{gpu::KernelBatch, ParentQuadrant, PatchJob, RiverSample},
     planet::{cube::PatchId, detail::PatchHeights},
-    refine::{create_height_texture, prepare_height_textures, RefineJob, RefinedRanges},
+    refine::{prepare_height_textures, RefineJob, RefinedRanges},
     river::samples::{patch_samples, PatchFrame},
 };
 
@@ -78,116 +78,97 @@ impl Renderer<'_> {
                 ranges: None,
             });
         }
-        let ctx = self.ctx;
         let n = self.config.rendering.vertices;
-        let mut bases: Vec<(Image, Slot)> = Vec::with_capacity(prepared.len());
-        for p in prepared {
-            let image = create_height_texture(ctx, n, &format!("base heights {:?}", p.patch))?;
-            let slot = self.slot()?;
-            self.bindless.write(ctx, slot, &image, true);
-            bases.push((image, slot));
-        }
-        let base_refs: Vec<&Image> = bases.iter().map(|(i, _)| i).collect();
-        prepare_height_textures(rec, &base_refs);
-        // Slot and height range (border included) of each new patch: exact for uploaded ones, a bound for
+        let bases = (0..prepared.len())
+            .map(|_| self.texture_place(TextureKind::Heights))
+            .collect::<Result<Vec<SlotLayer>, GpuError>>()?;
+        prepare_height_textures(rec, &self.textures.heights.images(bases.iter().copied()));
+        // Place and height range (border included) of each new patch: exact for uploaded ones, a bound for
         // refined ones until the shader's own range is read back after the frame.
-        let mut made: HashMap<PatchId, (Slot, (f32, f32))> = HashMap::new();
+        let mut made: HashMap<PatchId, (SlotLayer, (f32, f32))> = HashMap::new();
         let mut jobs: Vec<RefineJob> = Vec::new();
-        for (p, (image, slot)) in prepared.iter().zip(&bases) {
+        for (p, &place) in prepared.iter().zip(&bases) {
             let range = match &p.heights {
                 Some(heights) => {
-                    rec.upload_image_layer(image, 0, bytemuck::cast_slice(&heights.data))?;
+                    let image = self.textures.heights.image(place).ok_or_else(|| {
+                        GpuError::Invalid(format!("no height image at {place:?}"))
+                    })?;
+                    rec.upload_image_layer(
+                        image,
+                        place.layer,
+                        bytemuck::cast_slice(&heights.data),
+                    )?;
                     heights.range()
                 }
                 None => {
                     let parent = p.patch.parent().expect("refined patches have parents");
-                    let (parent_slot, (lo, hi)) = match made.get(&parent) {
+                    let (parent_place, (lo, hi)) = match made.get(&parent) {
                         Some(&made) => made,
                         None => {
                             let data = self.cache.touch(&parent).ok_or_else(|| {
                                 GpuError::Invalid(format!("{:?} has no resident parent", p.patch))
                             })?;
-                            (data.base_slot, data.height_range)
+                            (data.base, data.height_range)
                         }
                     };
                     jobs.push(RefineJob {
                         patch: p.patch,
-                        slot: *slot,
-                        parent_slot,
+                        place,
+                        parent_place,
                     });
                     let extra = self.planet.rule.remaining_range(p.patch.level as u32 - 1);
                     (lo - extra, hi + extra)
                 }
             };
-            made.insert(p.patch, (*slot, range));
+            made.insert(p.patch, (place, range));
         }
         let mut bytes = 0;
         let mut ranges = None;
         if !jobs.is_empty() {
-            // The parents' textures: made in this frame, or resident from an earlier one.
-            let made_here: HashMap<Slot, &Image> = bases.iter().map(|(i, s)| (*s, i)).collect();
-            let cache = &self.cache;
-            let parent_texture = |job: &RefineJob| {
-                made_here
-                    .get(&job.parent_slot)
-                    .copied()
-                    .or_else(|| cache.peek(&job.patch.parent()?).map(|data| &data.base))
-            };
             let (refiner, bindless, planet) = (&self.refiner, &self.bindless, self.planet);
+            let heights = &self.textures.heights;
             ranges = self.frames.profiler().scope(rec, "heights", |rec| {
-                refiner.record(rec, (bindless, planet), &jobs, parent_texture)
+                refiner.record(rec, (bindless, planet), &jobs, |place| heights.image(place))
             })??;
             bytes += ranges.as_ref().map_or(0, |r| r.bytes);
         }
         // Read by the terrain's shaders, and by the vertex cache's compute pass before them (draw.rs): without the
         // compute stage here, a GPU could compute a new patch's vertices before its heights were written.
         rec.use_images(
-            &base_refs,
+            &self.textures.heights.images(bases.iter().copied()),
             &[Access::GraphicsSampled, Access::ComputeSampled],
         );
 
-        let mut rivers: Vec<(Image, Slot)> = Vec::new();
+        let mut rivers: Vec<SlotLayer> = Vec::new();
         let mut patch_jobs: Vec<PatchJob> = Vec::new();
-        let mut parents: Vec<Option<(Slot, ParentQuadrant)>> = Vec::new();
+        let mut parents: Vec<Option<(SlotLayer, ParentQuadrant)>> = Vec::new();
         let mut river_of: Vec<Option<usize>> = Vec::with_capacity(prepared.len());
         for p in prepared {
             if p.samples.is_empty() {
                 river_of.push(None);
                 continue;
             }
-            let slot = self.slot()?;
-            let image = create_river_texture(ctx, n, &format!("river data {:?}", p.patch))?;
-            self.bindless.write(ctx, slot, &image, true);
+            let place = self.texture_place(TextureKind::River)?;
             patch_jobs.push(PatchJob {
                 spacing: PatchFrame::new(p.patch, self.planet.radius, n).spacing() as f32,
                 samples: &p.samples,
             });
             parents.push(self.river_parent(p.patch));
             river_of.push(Some(rivers.len()));
-            rivers.push((image, slot));
+            rivers.push(place);
         }
-        let slots: Vec<Slot> = rivers.iter().map(|(_, s)| *s).collect();
         if let (false, Some(observe)) = (patch_jobs.is_empty(), &mut self.kernel_observer) {
             observe(&patch_jobs);
         }
         if !rivers.is_empty() {
-            let textures: Vec<&Image> = rivers.iter().map(|(i, _)| i).collect();
-            // The resident parents' river textures (made in earlier frames), each once.
-            let mut parent_patches: Vec<PatchId> = prepared
-                .iter()
-                .zip(&river_of)
-                .filter(|(_, river)| river.is_some_and(|k| parents[k].is_some()))
-                .filter_map(|(p, _)| p.patch.parent())
-                .collect();
-            parent_patches.sort_unstable();
-            parent_patches.dedup();
-            let parent_textures: Vec<&Image> = parent_patches
-                .iter()
-                .filter_map(|q| self.cache.peek(q)?.river.as_ref().map(|(image, _)| image))
-                .collect();
+            let river_images = &self.textures.rivers;
+            let textures = river_images.images(rivers.iter().copied());
+            // The resident parents' river textures (made in earlier frames), each image once.
+            let parent_textures =
+                river_images.images(parents.iter().flatten().map(|(place, _)| *place));
             let batch = KernelBatch {
                 textures: &textures,
-                slots: &slots,
+                places: &rivers,
                 jobs: &patch_jobs,
                 parents: &parents,
                 parent_textures: &parent_textures,
@@ -203,15 +184,12 @@ impl Renderer<'_> {
             );
         }
         let river_count = rivers.len();
-        let mut rivers: Vec<Option<(Image, Slot)>> = rivers.into_iter().map(Some).collect();
-        for ((p, (base, slot)), river) in prepared.iter().zip(bases).zip(river_of) {
-            let river = river.and_then(|k| rivers[k].take());
+        for ((p, base), river) in prepared.iter().zip(bases).zip(river_of) {
             self.cache.insert(
                 p.patch,
                 PatchData {
                     base,
-                    base_slot: slot,
-                    river,
+                    river: river.map(|k| rivers[k]),
                     river_final: p.final_detail,
                     height_range: made[&p.patch].1,
                     river_range: river_range(&p.samples, self.config.river.basin_depth),
@@ -231,14 +209,14 @@ impl Renderer<'_> {
     /// Where `patch` takes river data from (10.2): its parent's river texture and quadrant, when parent reuse is
     /// on and the resident parent has the rivers' final detail (it was made in an earlier frame: the cache
     /// holds only those).
-    fn river_parent(&mut self, patch: PatchId) -> Option<(Slot, ParentQuadrant)> {
+    fn river_parent(&mut self, patch: PatchId) -> Option<(SlotLayer, ParentQuadrant)> {
         if !self.parent_reuse {
             return None;
         }
         let quadrant = ParentQuadrant::of(patch, self.config.rendering.vertices)?;
         let data = self.cache.touch(&patch.parent()?)?;
-        let (_, slot) = data.river.as_ref().filter(|_| data.river_final)?;
-        Some((*slot, quadrant))
+        let place = data.river.filter(|_| data.river_final)?;
+        Some((place, quadrant))
     }
 }
 
