@@ -161,11 +161,24 @@ vec3 throughAir(vec3 colour) {
 // small to see).
 const float FOAM_COVER = 0.15;
 
+// How deep a river looks: the painting's water, half a colour band deep (Section 8.4).
+float riverLookDepth() { return 0.5 * frame.extra.z; }
+
+// How much of the ground standing water hides: more the deeper it is.
+float depthOpacity(float depth) { return clamp(0.55 + depth / frame.extra.z * 0.3, 0.55, 0.92); }
+
+// Beyond the thesis (docs/rendering.md, "River water"): a river the mesh carves is drawn as the painting draws it,
+// opaque and half a colour band deep, but for the outer part of its channel, where the bed shows through towards the
+// bank. Its real depth (the basin's, a fraction of a colour band) made it pale and translucent, so a river changed
+// from dark to pale as the camera came close enough for the mesh to carve it. `bankShare`: |distance| / half width.
+float riverOpacity(float bankShare) { return 1.0 - 0.45 * smoothBand(0.6, 1.0, bankShare); }
+
 // Beyond the thesis: the lit colour and opacity of water, flowing unless still (the thesis's, Section 8.4): the
 // rippled normal, foam at the bank (rivers) or the shore (the sea) broken up by the moving ripples, the reflected
 // sky, the sun's glint. `q`: the fragment in ripple sizes, `visible`: how much the ripples and their fine octave
-// show (both from rippleSpace, in uniform control flow); `depth`: the water above the terrain.
-vec4 waterSurface(bool river, float depth, vec3 q, vec2 visible, vec3 up, vec3 view, vec3 sun) {
+// show (both from rippleSpace, in uniform control flow); `depth`: how deep the water looks (its colour);
+// `opacity`: how much of the ground it hides before its foam.
+vec4 waterSurface(bool river, float depth, float opacity, vec3 q, vec2 visible, vec3 up, vec3 view, vec3 sun) {
     vec3 wind = cross(up, vec3(0.0, 1.0, 0.0));
     vec3 velocity = river ? fFlow * 0.8 : wind * 0.15;
     vec3 q0, q1;
@@ -195,8 +208,7 @@ vec4 waterSurface(bool river, float depth, vec3 q, vec2 visible, vec3 up, vec3 v
     float reflectedUp = clamp(dot(reflect(-view, surface), up), 0.0, 1.0);
     vec3 sky = mix(vec3(0.62, 0.72, 0.84), vec3(0.16, 0.28, 0.55), sqrt(reflectedUp)) * (1.0 - foam);
     colour = mix(colour * (0.25 + 0.75 * diffuse), sky, fresnel * 0.8) + vec3(1.0, 0.95, 0.85) * fSunlight * specular * 0.8;
-    float alpha = max(clamp(0.55 + depth / frame.extra.z * 0.3, 0.55, 0.92), foam);
-    return vec4(colour, alpha);
+    return vec4(colour, max(opacity, foam));
 }
 
 // The fragment in ripple sizes (rivers: the river's half width; the sea: a unit of colour band, extra.z) and how
@@ -306,7 +318,11 @@ void main() {
         vec3 q = rippleSpace(river, visible);
         // River water covers the basin only: a triangle reaching past the banks is cut at the river's width.
         if (river && abs(fRiver.z) > fRiver.w) discard;
-        vec4 water = waterSurface(river, max(fRiver.y - fRiver.x, 0.0), q, visible, up, view, sun);
+        // Lakes reach the shaders as basins of a vast width: they keep their real depth.
+        bool carved = river && fRiver.w <= LAKE_HALF_WIDTH_FLOOR;
+        float depth = carved ? riverLookDepth() : max(fRiver.y - fRiver.x, 0.0);
+        float opacity = carved ? riverOpacity(abs(fRiver.z) / fRiver.w) : depthOpacity(depth);
+        vec4 water = waterSurface(river, depth, opacity, q, visible, up, view, sun);
         outColor = vec4(atmosphereOn() ? throughAir(water.rgb) : water.rgb, water.a);
         return;
     }
@@ -399,12 +415,15 @@ void main() {
     if (cover > 0.0) {
         bool paintedWater = !seaWater && !lakeWater && painted > 0.0;
         bool standing = seaWater || lakeWater;
-        float depth = seaWater ? sea - fRiver.x : lakeWater ? lakeDepth : paintedWater ? 0.5 * frame.extra.z
-                                                                        : fRiver.y - fRiver.x;
-        vec4 water = waterSurface(!standing, max(depth, 0.0), standing ? seaQ : q, standing ? seaVisible : visible, up,
+        // Lakes in the mesh reach the shaders as basins of a vast width: they keep their real depth.
+        bool carvedRiver = !standing && !paintedWater && fRiver.w <= LAKE_HALF_WIDTH_FLOOR;
+        float depth = seaWater ? sea - fRiver.x : lakeWater ? lakeDepth
+                    : paintedWater || carvedRiver ? riverLookDepth() : fRiver.y - fRiver.x;
+        depth = max(depth, 0.0);
+        // Painted rivers are opaque (the thesis's painting); carved ones as opaque but at the bank.
+        float opacity = paintedWater ? 1.0 : carvedRiver ? riverOpacity(abs(fRiver.z) / fRiver.w) : depthOpacity(depth);
+        vec4 water = waterSurface(!standing, depth, opacity, standing ? seaQ : q, standing ? seaVisible : visible, up,
                                   view, sun);
-        // Painted rivers are opaque (the thesis's painting).
-        if (paintedWater) water.a = 1.0;
         if (paintedWater && viewMode() == 2) water.rgb = vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse);
         colour = mix(colour, water.rgb, water.a * cover);
     }
