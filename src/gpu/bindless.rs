@@ -6,7 +6,7 @@
 use ash::vk;
 
 use super::{
-    retire::{RetireOnDrop, Retired},
+    retire::{Released, RetireOnDrop, Retired},
     Access, Context, GpuError, Image, VkResultExt,
 };
 
@@ -31,7 +31,7 @@ pub struct Bindless {
     free: Vec<u32>,
     /// Released slots with the timeline value after which no submitted frame reads them: a frame still in
     /// flight may read a slot's descriptor, which must not be rewritten until that frame has finished.
-    released: std::collections::VecDeque<(u64, u32)>,
+    released: Released<u32>,
     _retire: RetireOnDrop,
 }
 
@@ -171,30 +171,16 @@ impl Bindless {
     /// all are in use or still read by frames in flight.
     pub fn allocate(&mut self, ctx: &Context) -> Option<Slot> {
         if self.free.is_empty() {
-            self.reclaim(ctx);
+            self.released.reclaim_into(ctx, &mut self.free);
         }
         self.free.pop().map(Slot)
     }
 
-    /// Returns a slot once every submission made so far has completed (`reclaim`). Its old descriptors stay until
+    /// Returns a slot once every submission made so far has completed. Its old descriptors stay until
     /// overwritten; PARTIALLY_BOUND makes that legal.
     pub fn release(&mut self, ctx: &Context, slot: Slot) {
         debug_assert!(!self.free.contains(&slot.0));
-        self.released
-            .push_back((ctx.timeline.last_submitted(), slot.0));
-    }
-
-    /// Makes the released slots whose submissions have completed free again.
-    fn reclaim(&mut self, ctx: &Context) {
-        // A failed query (device loss) reclaims nothing; the next submission reports the loss.
-        let completed = ctx.timeline.completed(&ctx.device).unwrap_or(0);
-        while let Some(&(value, slot)) = self.released.front() {
-            if value > completed {
-                break;
-            }
-            self.free.push(slot);
-            self.released.pop_front();
-        }
+        self.released.push(ctx, slot.0);
     }
 
     /// Slots released but still read by frames in flight.

@@ -3,10 +3,9 @@
 //! allocation and one descriptor serve a page of textures instead of one each, and shaders index by a layer
 //! rather than by a descriptor that differs from patch to patch.
 
-use std::collections::VecDeque;
-
 use super::{
     bindless::{Bindless, SlotLayer, LAYERS_PER_SLOT},
+    retire::Released,
     Access, Context, Extent2D, Format, GpuError, Image, ImageDesc,
 };
 
@@ -32,8 +31,8 @@ pub struct LayerPool {
     capacity: usize,
     pages: Vec<(SlotLayer, Image)>,
     free: Vec<SlotLayer>,
-    /// Released places with the timeline value after which no submitted frame reads them.
-    released: VecDeque<(u64, SlotLayer)>,
+    /// Released places, until no submitted frame reads them.
+    released: Released<SlotLayer>,
     in_use: usize,
 }
 
@@ -51,7 +50,7 @@ impl LayerPool {
             capacity,
             pages: Vec::new(),
             free: Vec::new(),
-            released: VecDeque::new(),
+            released: Released::default(),
             in_use: 0,
         })
     }
@@ -75,7 +74,7 @@ impl LayerPool {
     ) -> Result<Option<SlotLayer>, GpuError> {
         let full = |pool: &Self| pool.in_use + pool.released.len() >= pool.capacity;
         if self.free.is_empty() || full(self) {
-            self.reclaim(ctx);
+            self.released.reclaim_into(ctx, &mut self.free);
         }
         if full(self) {
             return Ok(None);
@@ -92,8 +91,7 @@ impl LayerPool {
     pub fn release(&mut self, ctx: &Context, place: SlotLayer) {
         debug_assert!(!self.free.contains(&place));
         self.in_use -= 1;
-        self.released
-            .push_back((ctx.timeline.last_submitted(), place));
+        self.released.push(ctx, place);
     }
 
     /// Places released but still read by frames in flight.
@@ -174,19 +172,6 @@ impl LayerPool {
         }));
         self.pages.push((SlotLayer::whole(slot), image));
         Ok(())
-    }
-
-    /// Makes the released places whose submissions have completed free again.
-    fn reclaim(&mut self, ctx: &Context) {
-        // A failed query (device loss) reclaims nothing; the next submission reports the loss.
-        let completed = ctx.timeline.completed(&ctx.device).unwrap_or(0);
-        while let Some(&(value, place)) = self.released.front() {
-            if value > completed {
-                break;
-            }
-            self.free.push(place);
-            self.released.pop_front();
-        }
     }
 }
 

@@ -2,9 +2,10 @@
 //! `RetireOnDrop`) is retired: freed only after the GPU has finished every submission made before it was dropped,
 //! and the submission of any recording open when it was dropped (Granite's per-frame lists, keyed here by
 //! timeline-semaphore value). Dropping is retiring, so none can leak by being forgotten, and no owner calls
-//! `destroy`. A retired buffer or image whose GPU work is done is kept (the latest, up to [`RECYCLED_BYTES`]) for the next
-//! request of the same shape (kajiya's transient resource cache): the frame loop's staging, instance and
-//! per-dispatch buffers and the textures of evicted patches come back instead of being created again.
+//! `destroy`. A retired buffer or image whose GPU work is done is kept (the latest, up to [`RECYCLED_BYTES`]) for
+//! the next request of the same shape (kajiya's transient resource cache): the frame loop's staging, instance and
+//! per-dispatch buffers come back instead of being created again. Slots and texture layers handed back wait in a
+//! `Released` queue the same way.
 
 use std::{
     collections::VecDeque,
@@ -365,5 +366,38 @@ impl Context {
         self.collect_garbage();
         self.deletion
             .release_recycled(&self.device, &self.allocator);
+    }
+}
+
+/// Things handed back while submitted work may still read them (bindless slots, texture layers), each with the
+/// timeline value of the last submission made then: free again once that value has completed.
+pub(crate) struct Released<T>(VecDeque<(u64, T)>);
+
+impl<T> Default for Released<T> {
+    fn default() -> Self {
+        Self(VecDeque::new())
+    }
+}
+
+impl<T> Released<T> {
+    /// Hands `item` back after every submission made so far.
+    pub(crate) fn push(&mut self, ctx: &Context, item: T) {
+        self.0.push_back((ctx.timeline.last_submitted(), item));
+    }
+
+    /// Moves what the GPU is done with into `free`.
+    pub(crate) fn reclaim_into(&mut self, ctx: &Context, free: &mut Vec<T>) {
+        // A failed query (device loss) reclaims nothing; the next submission reports the loss.
+        let completed = ctx.timeline.completed(&ctx.device).unwrap_or(0);
+        while self.0.front().is_some_and(|(value, _)| *value <= completed) {
+            if let Some((_, item)) = self.0.pop_front() {
+                free.push(item);
+            }
+        }
+    }
+
+    /// Things still read by submitted work.
+    pub(crate) fn len(&self) -> usize {
+        self.0.len()
     }
 }
