@@ -408,7 +408,12 @@ void main() {
         lakeDepth = below;
         if (fRiver.w > LAKE_HALF_WIDTH_FLOOR) inRiver *= 1.0 - coarse;
     }
-    bool seaWater = underSea > 0.0;
+    // A river whose water stands above the sea covers the sea beneath it: its bed may dip below sea level near the
+    // coast, and the sea's antialiased contour there (underSea between 0 and 1) broke the river's water into lines
+    // of bare ground along the contour. At its mouth a river's water comes down to the sea's level and the sea
+    // covers it.
+    bool riverAbove = fRiver.y > sea && max(inRiver, painted) >= underSea;
+    bool seaWater = underSea > 0.0 && !riverAbove;
     bool lakeWater = !seaWater && lakeCover > max(inRiver, painted);
     float cover = seaWater ? underSea : max(max(inRiver, painted), lakeCover);
     // One evaluation of the water's surface for whichever water this pixel shows.
