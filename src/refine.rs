@@ -281,20 +281,8 @@ pub fn generate_on_gpu(
 ) -> Result<GpuPatches, GpuError> {
     let n = refiner.vertices;
     let all = with_ancestors(patches, planet.precomputed_level, |_| false);
-    let mut pool = LayerPool::new(height_textures(n), all.len())?;
-    let mut places: HashMap<PatchId, SlotLayer> = HashMap::new();
-    for p in &all {
-        let place = pool.allocate(ctx, bindless).and_then(|place| {
-            place.ok_or_else(|| GpuError::Invalid(format!("no room for {} patches", all.len())))
-        });
-        match place {
-            Ok(place) => places.insert(*p, place),
-            Err(e) => {
-                pool.release_slots(ctx, bindless);
-                return Err(e);
-            }
-        };
-    }
+    let (pool, made) = LayerPool::filled(height_textures(n), all.len(), ctx, bindless)?;
+    let places: HashMap<PatchId, SlotLayer> = all.iter().copied().zip(made).collect();
     let texel_bytes = (PatchHeights::side(n).pow(2) * 4) as u64;
     let readback = ctx.create_buffer(&BufferDesc {
         name: "height readback",

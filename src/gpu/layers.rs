@@ -55,6 +55,33 @@ impl LayerPool {
         })
     }
 
+    /// A pool holding exactly `count` textures of `kind`, and their places (for a batch made at once, as the
+    /// tests and benchmarks make theirs); on failure every slot taken is given back.
+    pub fn filled(
+        kind: LayerKind,
+        count: usize,
+        ctx: &Context,
+        bindless: &mut Bindless,
+    ) -> Result<(Self, Vec<SlotLayer>), GpuError> {
+        let mut pool = Self::new(kind, count)?;
+        let mut places = Vec::with_capacity(count);
+        while places.len() < count {
+            let place = pool.allocate(ctx, bindless).and_then(|place| {
+                place.ok_or_else(|| {
+                    GpuError::Invalid(format!("no room for {count} {} textures", kind.name))
+                })
+            });
+            match place {
+                Ok(place) => places.push(place),
+                Err(e) => {
+                    pool.release_slots(ctx, bindless);
+                    return Err(e);
+                }
+            }
+        }
+        Ok((pool, places))
+    }
+
     /// Textures one array image holds.
     pub fn textures_per_image(&self) -> u32 {
         LAYERS_PER_SLOT / self.kind.layers_per_texture

@@ -75,22 +75,7 @@ impl BatchOutputs {
             uses: &[Access::TransferWrite, Access::HostRead],
             location: MemoryLocation::GpuToCpu,
         })?;
-        let mut pool = LayerPool::new(river_textures(grid_size), patches)?;
-        let mut places = Vec::with_capacity(patches);
-        while places.len() < patches {
-            let place = pool.allocate(ctx, bindless).and_then(|place| {
-                place.ok_or_else(|| {
-                    GpuError::Invalid(format!("no room for {patches} river textures"))
-                })
-            });
-            match place {
-                Ok(place) => places.push(place),
-                Err(e) => {
-                    pool.release_slots(ctx, bindless);
-                    return Err(e);
-                }
-            }
-        }
+        let (pool, places) = LayerPool::filled(river_textures(grid_size), patches, ctx, bindless)?;
         Ok(Self {
             pool,
             places,
