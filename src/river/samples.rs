@@ -60,14 +60,59 @@ impl PatchFrame {
 
 /// Section 6.3: whether `system`'s extended hull meets the patch.
 pub fn influences(system: &RiverSystem, frame: &PatchFrame) -> bool {
-    if cube::angle(system.frame.centre, frame.patch.center())
-        > system.cap_angle + frame.patch.cap_angle()
-    {
-        return false;
+    let cap = PatchCap::of(frame);
+    cap.meets(system, frame, cap.bound(system.cap_angle))
+}
+
+/// The cap around a patch's centre that holds the patch: the first, cheap test of every system against the
+/// patch, computed once per patch rather than once per system (its corners' angles were most of the time a
+/// patch's samples took on a planet of a few thousand systems).
+#[derive(Clone, Copy)]
+struct PatchCap {
+    centre: DVec3,
+    angle: f64,
+}
+
+impl PatchCap {
+    fn of(frame: &PatchFrame) -> Self {
+        Self {
+            centre: frame.patch.center(),
+            angle: frame.patch.cap_angle(),
+        }
     }
-    frame
-        .outline_in(system)
-        .is_some_and(|outline| hull::intersects(&system.extended, &outline))
+
+    /// A quicker first test for `systems`, none of whose caps is wider than `widest` (radians): the cosine of
+    /// the angle beyond which none of them can meet this cap, less a margin for rounding, or -2 (no such angle).
+    /// A dot product against it passes every system the exact angle passes, and rejects most of a planet's
+    /// systems without the arc tangent.
+    fn bound(&self, widest: f64) -> f64 {
+        let reach = widest + self.angle;
+        if reach < std::f64::consts::PI {
+            reach.cos() - 1e-9
+        } else {
+            -2.0
+        }
+    }
+
+    /// Whether `system`'s extended hull meets the patch of `frame` (this cap's), with `bound` from
+    /// [`PatchCap::bound`] of a cap at least as wide as the system's.
+    fn meets(&self, system: &RiverSystem, frame: &PatchFrame, bound: f64) -> bool {
+        let centre = system.frame.centre;
+        if centre.dot(self.centre) < bound * centre.length() * self.centre.length() {
+            return false;
+        }
+        if cube::angle(centre, self.centre) > system.cap_angle + self.angle {
+            return false;
+        }
+        frame
+            .outline_in(system)
+            .is_some_and(|outline| hull::intersects(&system.extended, &outline))
+    }
+}
+
+/// The widest cap of `systems`.
+fn widest(systems: &[RiverSystem]) -> f64 {
+    systems.iter().map(|s| s.cap_angle).fold(0.0, f64::max)
 }
 
 /// The systems that influence a patch: the network's, and the streams a patch of its level draws.
@@ -75,17 +120,20 @@ pub fn influencing<'a>(
     network: &'a RiverNetwork,
     frame: &'a PatchFrame,
 ) -> impl Iterator<Item = &'a RiverSystem> {
-    let streams = network
-        .streams
-        .iter()
-        .flat_map(|s| s.systems.iter().map(move |system| (s.level, system)))
-        .filter(move |(level, system)| drawn_on(*level, system, frame))
-        .map(|(_, system)| system);
-    network
+    let cap = PatchCap::of(frame);
+    let bound = cap.bound(widest(&network.systems));
+    let rivers = network
         .systems
         .iter()
-        .chain(streams)
-        .filter(move |s| influences(s, frame))
+        .filter(move |s| cap.meets(s, frame, bound));
+    let streams = network.streams.iter().flat_map(move |level| {
+        let bound = cap.bound(widest(&level.systems));
+        level
+            .systems
+            .iter()
+            .filter(move |s| drawn_on(level.level, s, frame) && cap.meets(s, frame, bound))
+    });
+    rivers.chain(streams)
 }
 
 /// Whether a patch draws the streams of `level` in `system`: from their level on, once its vertices lie no
@@ -97,11 +145,14 @@ fn drawn_on(level: u32, system: &RiverSystem, frame: &PatchFrame) -> bool {
 
 /// Whether streams the patch does not draw yet reach it: then its descendants get samples it has not.
 fn finer_streams_reach(network: &RiverNetwork, frame: &PatchFrame) -> bool {
-    network
-        .streams
-        .iter()
-        .flat_map(|s| s.systems.iter().map(move |system| (s.level, system)))
-        .any(|(level, system)| !drawn_on(level, system, frame) && influences(system, frame))
+    let cap = PatchCap::of(frame);
+    network.streams.iter().any(|level| {
+        let bound = cap.bound(widest(&level.systems));
+        level
+            .systems
+            .iter()
+            .any(|s| !drawn_on(level.level, s, frame) && cap.meets(s, frame, bound))
+    })
 }
 
 /// A patch's river samples, and whether they are the rivers' final detail.
