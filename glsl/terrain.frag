@@ -15,11 +15,24 @@ layout(constant_id = 1) const uint LAKE_MAP = 0;
 
 layout(location = 0) out vec4 outColor;
 
-// Cheap value noise for procedural texture detail (no external assets).
-float hash(vec3 p) {
-    p = fract(p * 0.3183099 + 0.1);
-    p *= 17.0;
-    return fract(p.x * p.y * p.z * (p.x + p.y + p.z));
+// Cheap value noise for procedural texture detail (no external assets). The hash of a lattice point is
+// fract(x * y * z * (x + y + z)) of its coordinates, each scrambled alone (`scramble`), so a cell's eight corners
+// scramble six coordinates, not twenty-four (docs/rendering.md, "Cheaper pixels").
+vec3 scramble(vec3 p) { return fract(p * 0.3183099 + 0.1) * 17.0; }
+
+float hashScrambled(float x, float y, float z) { return fract(x * y * z * (x + y + z)); }
+
+// The hashes of a cell's eight corners from its scrambled low (`a`) and high (`b`) coordinates, corner k at
+// (k & 1, (k >> 1) & 1, k >> 2).
+void cornerHashes(vec3 a, vec3 b, out float c[8]) {
+    c[0] = hashScrambled(a.x, a.y, a.z);
+    c[1] = hashScrambled(b.x, a.y, a.z);
+    c[2] = hashScrambled(a.x, b.y, a.z);
+    c[3] = hashScrambled(b.x, b.y, a.z);
+    c[4] = hashScrambled(a.x, a.y, b.z);
+    c[5] = hashScrambled(b.x, a.y, b.z);
+    c[6] = hashScrambled(a.x, b.y, b.z);
+    c[7] = hashScrambled(b.x, b.y, b.z);
 }
 
 const vec3 DIRT = vec3(0.45, 0.36, 0.25);
@@ -36,9 +49,7 @@ float periodicNoise(vec3 x, float period) {
     vec3 f = fract(x);
     f = f * f * (3.0 - 2.0 * f);
     float c[8];
-    for (int k = 0; k < 8; ++k) {
-        c[k] = hash(mod(i + vec3(k & 1, (k >> 1) & 1, k >> 2), period));
-    }
+    cornerHashes(scramble(mod(i, period)), scramble(mod(i + 1.0, period)), c);
     return mix(mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y), mix(mix(c[4], c[5], f.x), mix(c[6], c[7], f.x), f.y),
                f.z);
 }
@@ -68,7 +79,8 @@ float groundDetail() {
     for (int k = 0; k < 3 && coarse > 0.0; ++k, size *= 4.0) {
         float pixels = size / max(footprint, 1e-6);
         float fade = coarse * (1.0 - smoothBand(0.35, 0.7, 1.0 / pixels)) * (1.0 - smoothBand(128.0, 1024.0, pixels));
-        sum += 0.4 * fade * (periodicNoise(fDetail / size, GROUND_DETAIL_PERIOD / size) - 0.5);
+        // Only the octaves that show (from orbit, most pixels show one or two of the three).
+        if (fade > 0.0) sum += 0.4 * fade * (periodicNoise(fDetail / size, GROUND_DETAIL_PERIOD / size) - 0.5);
     }
     return clamp(0.5 + sum / 1.4, 0.0, 1.0);
 }
@@ -106,8 +118,10 @@ vec4 noiseGradient(vec3 x) {
     vec3 f = fract(x);
     vec3 u = f * f * (3.0 - 2.0 * f);
     vec3 du = 6.0 * f * (1.0 - f);
-    float a = hash(i), b = hash(i + vec3(1, 0, 0)), c = hash(i + vec3(0, 1, 0)), d = hash(i + vec3(1, 1, 0));
-    float e = hash(i + vec3(0, 0, 1)), g = hash(i + vec3(1, 0, 1)), h = hash(i + vec3(0, 1, 1)), k = hash(i + vec3(1, 1, 1));
+    float corner[8];
+    cornerHashes(scramble(i), scramble(i + 1.0), corner);
+    float a = corner[0], b = corner[1], c = corner[2], d = corner[3];
+    float e = corner[4], g = corner[5], h = corner[6], k = corner[7];
     float kx = b - a, ky = c - a, kz = e - a;
     float kxy = a - b - c + d, kyz = a - c - e + h, kzx = a - b - e + g;
     float kxyz = -a + b + c - d + e - g - h + k;
