@@ -105,6 +105,10 @@ pub struct FlightSummary {
     pub average_gpu_ms: BTreeMap<String, f64>,
     /// See `average_gpu_ms`.
     pub average_cpu_ms: BTreeMap<String, f64>,
+    /// Fragment shader invocations per pixel of the target, per pass, averaged over the frames that counted
+    /// them (pipeline statistics queries; empty where the device has none): how often a pass shades a pixel,
+    /// its overdraw and the helper invocations of partly covered quads together.
+    pub fragments_per_pixel: BTreeMap<String, f64>,
     /// Frames with new river patches whose kernels were compared.
     pub kernel_frames: usize,
     /// Over those frames: average time of each kernel variant (ms), as Tables 9.1 and 9.2.
@@ -371,6 +375,7 @@ fn fly(
                 altitude,
                 stats: FrameStats {
                     gpu_ms: BTreeMap::new(),
+                    gpu_fragments: BTreeMap::new(),
                     ..stats
                 },
                 kernels,
@@ -393,11 +398,28 @@ fn fly(
     result.map(|()| frames)
 }
 
+/// Per pass, the mean of its fragment shader invocations over `pixels` across the frames that counted them.
+fn fragments_per_pixel(stats: &[&FrameStats], pixels: u64) -> BTreeMap<String, f64> {
+    let names: std::collections::BTreeSet<&String> =
+        stats.iter().flat_map(|s| s.gpu_fragments.keys()).collect();
+    names
+        .into_iter()
+        .map(|name| {
+            let per_pixel = stats
+                .iter()
+                .filter_map(|s| s.gpu_fragments.get(name))
+                .map(|&count| count as f64 / pixels.max(1) as f64);
+            (name.clone(), mean(per_pixel))
+        })
+        .collect()
+}
+
 /// Puts each finished frame's GPU times into its own frame's statistics: they arrive one or two frames late.
 fn attribute_gpu_times(frames: &mut [FlightFrame], times: Vec<GpuTimes>) {
     for t in times {
         if let Some(f) = frames.iter_mut().rev().find(|f| f.stats.frame == t.frame) {
             f.stats.gpu_ms = t.ms;
+            f.stats.gpu_fragments = t.fragments;
             f.stats.gpu_frame = t.frame;
         }
     }
@@ -412,7 +434,7 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
-fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
+fn summarise(frames: &[FlightFrame], budget: usize, pixels: u64) -> FlightSummary {
     let stats: Vec<&FrameStats> = frames.iter().map(|f| &f.stats).collect();
     let frame_ms: Vec<f64> = stats.iter().map(|s| s.frame_ms).collect();
     let frame_ms_mean = mean(frame_ms.iter().copied());
@@ -512,6 +534,7 @@ fn summarise(frames: &[FlightFrame], budget: usize) -> FlightSummary {
         resident_patch_budget: budget,
         average_gpu_ms: keys(&|s| &s.gpu_ms),
         average_cpu_ms: keys(&|s| &s.cpu_ms),
+        fragments_per_pixel: fragments_per_pixel(&stats, pixels),
         kernel_frames: kernel_frames.len(),
         kernel_average_ms,
         kernel_ratios,
@@ -548,7 +571,12 @@ pub fn flight_bench(
         |f| progress("auto", f),
     );
     let frames = frames?;
-    let mut summary = summarise(&frames, config.rendering.max_resident_patches as usize);
+    let pixels = options.size[0] as u64 * options.size[1] as u64;
+    let mut summary = summarise(
+        &frames,
+        config.rendering.max_resident_patches as usize,
+        pixels,
+    );
     summary
         .water_mode_frame_ms
         .insert("auto".into(), summary.frame_ms_mean);
@@ -599,16 +627,20 @@ pub fn to_csv(report: &FlightReport) -> String {
         "frame,altitude,visible_patches,new_patches,river_patches,fallback_patches,samples,frame_ms,gpu_kernel_ms,\
          gpu_terrain_ms,gpu_water_ms,memory_bytes,patch_texture_bytes,temporary_sample_bytes,resident_patches,\
          cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms,paced,cpu_cull_ms,cpu_lod_ms,cpu_samples_ms,\
-         cpu_wait_ms,cpu_upload_ms,cpu_record_ms,cpu_submit_ms\n",
+         cpu_wait_ms,cpu_upload_ms,cpu_record_ms,cpu_submit_ms,terrain_fragments_per_pixel\n",
     );
     for f in &report.frames {
         let s = &f.stats;
         let g = |k: &str| s.gpu_ms.get(k).copied().unwrap_or(0.0);
         let c = |k: &str| s.cpu_ms.get(k).copied().unwrap_or(0.0);
         let k = f.kernels.clone().unwrap_or_default();
+        let pixels = (report.resolution[0] as u64 * report.resolution[1] as u64).max(1);
+        let fragments = s.gpu_fragments.get("terrain").map_or(String::new(), |&n| {
+            format!("{:.3}", n as f64 / pixels as f64)
+        });
         out.push_str(&format!(
             "{},{:.3},{},{},{},{},{},{:.3},{:.4},{:.3},{:.3},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{},{:.3},{:.3},{:.3},\
-             {:.3},{:.3},{:.3},{:.3}\n",
+             {:.3},{:.3},{:.3},{:.3},{}\n",
             s.frame,
             f.altitude,
             s.visible_patches,
@@ -636,6 +668,7 @@ pub fn to_csv(report: &FlightReport) -> String {
             c("upload"),
             c("record"),
             c("submit"),
+            fragments,
         ));
     }
     out

@@ -219,6 +219,9 @@ pub fn run_bench(options: &ContextOptions, what: BenchCommand) -> anyhow::Result
             );
             println!("  gpu ms per frame: {:?}", s.average_gpu_ms);
             println!("  cpu ms per frame: {:?}", s.average_cpu_ms);
+            if !s.fragments_per_pixel.is_empty() {
+                println!("  fragments shaded per pixel: {:?}", s.fragments_per_pixel);
+            }
             if s.kernel_frames > 0 {
                 println!(
                     "  kernel over {} frames, average ms: {:?}",

@@ -37,6 +37,9 @@ pub struct Context {
     pub subgroup: features::SubgroupProperties,
     /// The bits of the queue's timestamps that count (0: no timestamps).
     pub timestamp_valid_bits: u32,
+    /// Whether pipeline statistics queries are enabled (an optional feature): the profiler then counts each
+    /// scope's fragment shader invocations too.
+    pub pipeline_statistics: bool,
     pub(super) validation_log: Box<ValidationLog>,
     pub(super) validation_enabled: bool,
     /// What `riverplanet info` shows of the device.
@@ -119,6 +122,11 @@ impl Context {
         };
 
         let mut enabled = features::EnabledFeatures::required();
+        // SAFETY: `physical` comes from this instance.
+        let pipeline_statistics = unsafe { instance.get_physical_device_features(physical) }
+            .pipeline_statistics_query
+            == vk::TRUE;
+        enabled.core.pipeline_statistics_query = pipeline_statistics as vk::Bool32;
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
@@ -190,6 +198,7 @@ impl Context {
             properties,
             subgroup,
             timestamp_valid_bits,
+            pipeline_statistics,
             validation_log,
             validation_enabled,
             adapter,

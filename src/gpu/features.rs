@@ -1,5 +1,7 @@
 //! The device features riverplanet requires, negotiated in one place (wgpu-hal's `PhysicalDeviceFeatures`):
 //! queried once, reported by `riverplanet info`, enabled exactly as listed, and a missing one is an error naming it.
+//! One optional feature is enabled where the device has it (`Context::pipeline_statistics`): pipeline statistics
+//! queries, with which the profiler counts fragments.
 
 use ash::vk;
 

@@ -1,5 +1,7 @@
 //! GPU timestamps: a query pool of named begin/end pairs, reset from the host, read after the submission's
-//! completion, masked to `timestampValidBits` and scaled by `timestampPeriod`.
+//! completion, masked to `timestampValidBits` and scaled by `timestampPeriod`. Where the device has pipeline
+//! statistics queries, each scope also counts its fragment shader invocations (how many times the pass shades a
+//! pixel: its overdraw, with the helper invocations of partly covered quads that a device reports).
 //! Each scope is also a debug label, so captures show the same names.
 
 use ash::vk;
@@ -16,11 +18,15 @@ pub struct ScopeTiming {
     pub name: String,
     /// Between its begin and end timestamps, milliseconds.
     pub ms: f64,
+    /// Its fragment shader invocations, where the device counts them.
+    pub fragments: Option<u64>,
 }
 
 /// Timestamp queries around named scopes of a recording, read back once its submission has finished.
 pub struct Profiler {
     pool: vk::QueryPool,
+    /// One pipeline statistics query (fragment shader invocations) per scope, where the device has them.
+    fragments: Option<vk::QueryPool>,
     capacity: u32,
     names: Vec<String>,
     period_ns: f64,
@@ -41,11 +47,27 @@ impl Profiler {
         // SAFETY: valid create info; destroyed through the deletion queue.
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
         ctx.set_name(pool, name);
+        let mut retired = vec![Retired::QueryPool(pool)];
+        let fragments = if ctx.pipeline_statistics {
+            let info = vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::PIPELINE_STATISTICS)
+                .pipeline_statistics(vk::QueryPipelineStatisticFlags::FRAGMENT_SHADER_INVOCATIONS)
+                .query_count(max_scopes);
+            // SAFETY: valid create info (the feature is enabled); destroyed through the deletion queue.
+            let stats =
+                unsafe { ctx.device.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+            ctx.set_name(stats, &format!("{name} fragments"));
+            retired.push(Retired::QueryPool(stats));
+            Some(stats)
+        } else {
+            None
+        };
         let bits = ctx.timestamp_valid_bits;
         let mut profiler = Self {
             pool,
+            fragments,
             capacity: max_scopes,
-            _retire: ctx.retire_on_drop(vec![Retired::QueryPool(pool)]),
+            _retire: ctx.retire_on_drop(retired),
             names: Vec::new(),
             period_ns: ctx.properties.limits.timestamp_period as f64,
             valid_mask: if bits >= 64 {
@@ -62,6 +84,10 @@ impl Profiler {
     pub fn reset(&mut self, ctx: &Context) {
         // SAFETY: hostQueryReset is a required feature; no pending submission uses these queries (caller's contract).
         unsafe { ctx.device.reset_query_pool(self.pool, 0, self.capacity * 2) };
+        if let Some(fragments) = self.fragments {
+            // SAFETY: as above.
+            unsafe { ctx.device.reset_query_pool(fragments, 0, self.capacity) };
+        }
         self.names.clear();
     }
 
@@ -98,7 +124,17 @@ impl Profiler {
                 vk::PipelineStageFlags2::ALL_COMMANDS,
                 self.pool,
                 index * 2,
-            )
+            );
+            // Scopes do not nest, so no other statistics query is active; begun and ended in the same place
+            // relative to a rendering (the scope's body begins and ends any rendering it records).
+            if let Some(fragments) = self.fragments {
+                ctx.device.cmd_begin_query(
+                    rec.cmd,
+                    fragments,
+                    index,
+                    vk::QueryControlFlags::empty(),
+                );
+            }
         };
         Ok(Scope(index))
     }
@@ -108,6 +144,9 @@ impl Profiler {
         let ctx = rec.ctx();
         // SAFETY: as in begin.
         unsafe {
+            if let Some(fragments) = self.fragments {
+                ctx.device.cmd_end_query(rec.cmd, fragments, scope.0);
+            }
             ctx.device.cmd_write_timestamp2(
                 rec.cmd,
                 vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -135,6 +174,23 @@ impl Profiler {
             )
         }
         .vk("vkGetQueryPoolResults")?;
+        let fragments = match self.fragments {
+            Some(pool) => {
+                let mut counts = vec![0u64; self.names.len()];
+                // SAFETY: as above; one 64-bit value per query (one statistic).
+                unsafe {
+                    ctx.device.get_query_pool_results(
+                        pool,
+                        0,
+                        &mut counts,
+                        vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                    )
+                }
+                .vk("vkGetQueryPoolResults")?;
+                Some(counts)
+            }
+            None => None,
+        };
         Ok(self
             .names
             .iter()
@@ -146,6 +202,7 @@ impl Profiler {
                 ScopeTiming {
                     name: name.clone(),
                     ms: ticks as f64 * self.period_ns * 1e-6,
+                    fragments: fragments.as_ref().map(|counts| counts[i]),
                 }
             })
             .collect())

@@ -30,6 +30,8 @@ pub struct GpuTimes {
     pub frame: u64,
     /// Milliseconds per pass.
     pub ms: BTreeMap<String, f64>,
+    /// Fragment shader invocations per pass, where the device counts them (empty where not).
+    pub fragments: BTreeMap<String, u64>,
 }
 
 impl Renderer<'_> {
@@ -63,6 +65,7 @@ impl Renderer<'_> {
     pub(super) fn report_latest_gpu_times(&self, stats: &mut FrameStats) {
         if let Some(latest) = &self.latest_gpu_times {
             stats.gpu_ms = latest.ms.clone();
+            stats.gpu_fragments = latest.fragments.clone();
             stats.gpu_frame = latest.frame;
         }
     }
@@ -86,7 +89,11 @@ impl Renderer<'_> {
                 self.last_capture = Some(capture);
             }
             let mut ms = BTreeMap::new();
+            let mut fragments = BTreeMap::new();
             for scope in timings {
+                if let Some(count) = scope.fragments {
+                    *fragments.entry(scope.name.clone()).or_default() += count;
+                }
                 *ms.entry(scope.name).or_default() += scope.ms;
             }
             self.measure_generation(payload.new_patches, &ms);
@@ -94,6 +101,7 @@ impl Renderer<'_> {
             let times = GpuTimes {
                 frame: payload.frame,
                 ms,
+                fragments,
             };
             self.latest_gpu_times = Some(times.clone());
             // A bounded backlog for callers that never take them (the viewer reads FrameStats instead).

@@ -48,6 +48,9 @@ pub struct FrameStats {
     /// GPU time per pass of frame `gpu_frame`: the latest that finished by the end of this call, one or two
     /// frames before this one (frames in flight); empty until the first has finished.
     pub gpu_ms: BTreeMap<String, f64>,
+    /// Fragment shader invocations per pass of frame `gpu_frame`, where the device counts them (pipeline
+    /// statistics queries; empty where not): per pixel of the target, how often a pass shades each.
+    pub gpu_fragments: BTreeMap<String, u64>,
     /// The frame `gpu_ms` belongs to.
     pub gpu_frame: u64,
     /// Frames submitted and not yet finished on the GPU when this call returned (this one included).
