@@ -3,9 +3,7 @@
 //! handed back, for their owner to free; the six roots stay, so every patch always has a resident ancestor to
 //! stand in for it while its own data is on the way.
 
-use std::collections::HashMap;
-
-use crate::planet::cube::PatchId;
+use crate::planet::cube::{PatchId, PatchMap};
 
 struct Entry<D> {
     data: D,
@@ -14,7 +12,7 @@ struct Entry<D> {
 
 /// Resident patches with payload `D`, with LRU eviction beyond `capacity` patches.
 pub struct PatchCache<D> {
-    entries: HashMap<PatchId, Entry<D>>,
+    entries: PatchMap<Entry<D>>,
     /// Patches held at most.
     pub capacity: usize,
     frame: u64,
@@ -24,7 +22,7 @@ impl<D> PatchCache<D> {
     /// An empty cache of `capacity` patches (at least the six roots).
     pub fn new(capacity: usize) -> Self {
         Self {
-            entries: HashMap::new(),
+            entries: PatchMap::default(),
             capacity: capacity.max(6),
             frame: 0,
         }

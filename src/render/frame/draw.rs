@@ -2,7 +2,7 @@
 //! in), with its morph towards its parent; the terrain drawn per quadrant, then the water through the geometry
 //! shader, then the sky where no surface is; optionally every terrain vertex captured as the vertex shader placed it.
 
-use std::{collections::HashMap, ops::Range};
+use std::ops::Range;
 
 use glam::DVec3;
 
@@ -17,7 +17,7 @@ use crate::{
         pipeline::{Attachment, RenderTarget},
         Access, Buffer, BufferDesc, GpuError, MemoryLocation, Recorder,
     },
-    planet::cube::{PatchId, EDGES},
+    planet::cube::{PatchId, PatchMap, EDGES},
     runtime::{camera::Camera, lod::Selected},
     shader_types::PatchInstance,
 };
@@ -139,7 +139,7 @@ impl Renderer<'_> {
     /// The visible patches drawn from an ancestor's data, each with how far its surface can lie from the true one:
     /// the span of that ancestor's heights (base and river beds).
     fn stand_in_spans(&self, visible: &[Selected]) -> StandIns {
-        let drawn: HashMap<PatchId, f32> = visible
+        let drawn: PatchMap<f32> = visible
             .iter()
             .filter(|s| !self.cache.contains(&s.patch))
             .filter_map(|s| {
@@ -148,7 +148,7 @@ impl Renderer<'_> {
                 Some((s.patch, hi - lo))
             })
             .collect();
-        let mut below: HashMap<PatchId, f32> = HashMap::new();
+        let mut below: PatchMap<f32> = PatchMap::default();
         for (patch, span) in &drawn {
             let mut p = patch.parent();
             while let Some(q) = p {
@@ -465,8 +465,8 @@ struct DrawnPatch {
 /// The visible patches drawn from an ancestor's data with the span of that ancestor's heights, and for every
 /// patch above one of them the largest such span below it.
 struct StandIns {
-    drawn: HashMap<PatchId, f32>,
-    below: HashMap<PatchId, f32>,
+    drawn: PatchMap<f32>,
+    below: PatchMap<f32>,
 }
 
 /// Share of a level's switch distance over which its patches morph into their parent's shape (CDLOD's morph
