@@ -17,6 +17,7 @@ pub mod bench;
 pub mod config;
 pub mod drainage;
 pub mod export;
+pub mod fast_hash;
 pub mod geomorphology;
 pub mod gpu;
 pub mod interrupt;

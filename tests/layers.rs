@@ -71,6 +71,7 @@ fn the_model_names_no_layer_above_it_and_runtime_no_gpu_type() {
         "src/drainage/",
         "src/config/",
         "src/rng.rs",
+        "src/fast_hash.rs",
         "src/shader_types.rs",
     ];
     let above = [

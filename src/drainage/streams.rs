@@ -8,44 +8,15 @@
 //! grows to a river of the coarser level without meeting a drawn course (a re-routed copy that strayed further),
 //! and a stream that ends in a lake only the finer level holds (it would end in nothing drawn).
 
-use std::{
-    collections::HashMap,
-    hash::{BuildHasherDefault, Hasher},
-};
-
 use glam::{DVec3, IVec3};
 
 use super::{LakeShape, ReachPath};
+use crate::fast_hash::FastMap;
 
 /// The drawn courses, as points on the unit sphere with their bed (or lake) heights, in a grid of cells.
 pub struct Courses {
     cell: f64,
-    cells: HashMap<IVec3, Vec<Course>, BuildHasherDefault<CellHasher>>,
-}
-
-/// A multiply-rotate hash of a grid cell's three integers (the Fx hash): the default SipHash made the queries of
-/// a level's hundreds of thousands of stream points a third of its time.
-#[derive(Default)]
-struct CellHasher(u64);
-
-impl Hasher for CellHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u32(b as u32);
-        }
-    }
-
-    fn write_i32(&mut self, i: i32) {
-        self.write_u32(i as u32);
-    }
-
-    fn write_u32(&mut self, i: u32) {
-        self.0 = (self.0.rotate_left(5) ^ i as u64).wrapping_mul(0x517c_c1b7_2722_0a95);
-    }
-
-    fn finish(&self) -> u64 {
-        self.0
-    }
+    cells: FastMap<IVec3, Vec<Course>>,
 }
 
 /// A point of a drawn course.
@@ -77,7 +48,7 @@ impl Courses {
     pub fn new(cell: f64) -> Self {
         Self {
             cell,
-            cells: HashMap::default(),
+            cells: FastMap::default(),
         }
     }
 

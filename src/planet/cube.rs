@@ -4,12 +4,9 @@
 //! `u_axis x v_axis = normal` (outward, counter-clockwise seen from outside). Normalising a cube point gives the
 //! sphere point; scaling by the radius gives the planet. The orientation of every face is in docs/planet.md.
 
-use std::{
-    collections::HashMap,
-    hash::{BuildHasherDefault, Hasher},
-};
-
 use glam::DVec3;
+
+use crate::fast_hash::FastMap;
 
 /// The six faces: +X, -X, +Y, -Y, +Z, -Z.
 pub const FACES: usize = 6;
@@ -61,41 +58,9 @@ pub fn face_of(direction: DVec3) -> (usize, f64, f64) {
     (face, p.dot(u_axis), p.dot(v_axis))
 }
 
-/// A map keyed by patch, hashed by [`PatchHasher`].
-pub type PatchMap<V> = HashMap<PatchId, V, BuildHasherDefault<PatchHasher>>;
-
-/// A hasher for patch keys (FxHash's multiply-and-rotate over the four fields): the caches are looked up for every
-/// patch the level of detail visits and every quadrant culled, each frame, and the default SipHash was about a seventh
-/// of that work in the thesis's stress flight. Patch keys come from the renderer, never from outside, so nothing
-/// needs the default's resistance to chosen keys.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct PatchHasher(u64);
-
-impl PatchHasher {
-    fn mix(&mut self, word: u64) {
-        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-}
-
-impl Hasher for PatchHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.mix(b as u64);
-        }
-    }
-
-    fn write_u8(&mut self, n: u8) {
-        self.mix(n as u64);
-    }
-
-    fn write_u32(&mut self, n: u32) {
-        self.mix(n as u64);
-    }
-
-    fn finish(&self) -> u64 {
-        self.0
-    }
-}
+/// A map keyed by patch, hashed by [`FastHasher`](crate::fast_hash::FastHasher): the caches are looked up for
+/// every patch the level of detail visits and every quadrant culled, each frame.
+pub type PatchMap<V> = FastMap<PatchId, V>;
 
 /// The angle between two directions, accurate for tiny angles too (atan2 of the cross and dot products; the
 /// arc cosine of the dot product loses all precision below about 1e-7 rad, the size of a level-20 patch).
