@@ -629,12 +629,12 @@ pub fn to_csv(report: &FlightReport) -> String {
          cpu_single_ms,cpu_rayon_ms,gpu_simple_ms,gpu_tiled_ms,paced,cpu_cull_ms,cpu_lod_ms,cpu_samples_ms,\
          cpu_wait_ms,cpu_upload_ms,cpu_record_ms,cpu_submit_ms,terrain_fragments_per_pixel\n",
     );
+    let pixels = (report.resolution[0] as u64 * report.resolution[1] as u64).max(1);
     for f in &report.frames {
         let s = &f.stats;
         let g = |k: &str| s.gpu_ms.get(k).copied().unwrap_or(0.0);
         let c = |k: &str| s.cpu_ms.get(k).copied().unwrap_or(0.0);
         let k = f.kernels.clone().unwrap_or_default();
-        let pixels = (report.resolution[0] as u64 * report.resolution[1] as u64).max(1);
         let fragments = s.gpu_fragments.get("terrain").map_or(String::new(), |&n| {
             format!("{:.3}", n as f64 / pixels as f64)
         });
