@@ -7,7 +7,7 @@ use std::{cell::RefCell, collections::BTreeMap, rc::Rc};
 use serde::Serialize;
 
 use super::{
-    holes::{hole_pixels, HOLE_COLOUR},
+    holes::{hole_check_clear, Holes},
     kernel::VariantRunner,
     path::Flight,
     Threads,
@@ -54,7 +54,7 @@ pub struct FlightFrame {
     /// The kernel variants on the frame's new river patches, where compared.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub kernels: Option<FrameKernels>,
-    /// Pixels inside the planet's disc showing the clear colour (the descent checks every tenth frame).
+    /// Pixels inside the planet's disc that no surface covered (the descent checks every tenth frame).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hole_pixels: Option<usize>,
     /// Whether the frame's time is the renderer's alone. Not for a frame at which the benchmark waited for the GPU
@@ -318,11 +318,7 @@ fn fly(
             let start = std::time::Instant::now();
             let mut stats = renderer.render(
                 &camera,
-                &target.target(if options.descent {
-                    HOLE_COLOUR
-                } else {
-                    [0.02, 0.03, 0.06, 1.0]
-                }),
+                &target.target(hole_check_clear(crate::render::SPACE)),
                 Access::ColorAttachment,
                 &[],
                 &[],
@@ -354,19 +350,19 @@ fn fly(
             };
             let hole_pixels = if check_holes {
                 let image = target.read(ctx)?;
-                let holes = hole_pixels(&image, &camera, inner).0;
+                let holes = Holes::find(&image, &camera, inner);
                 let save = |dir: &std::path::Path, name: String| {
                     let path = dir.join(name);
-                    crate::export::files::save_image(&image, &path)
+                    crate::export::files::save_image(&holes.shown_on(&image), &path)
                         .map_err(|e| GpuError::Invalid(e.to_string()))
                 };
-                if let (true, Some(dir)) = (holes > 0, &options.hole_images) {
+                if let (true, Some(dir)) = (holes.count() > 0, &options.hole_images) {
                     save(dir, format!("holes-{frame:03}.png"))?;
                 }
                 if let Some(dir) = &options.frame_images {
                     save(dir, format!("frame-{frame:03}.png"))?;
                 }
-                Some(holes)
+                Some(holes.count())
             } else {
                 None
             };

@@ -308,7 +308,7 @@ impl App<'_> {
         let Some((index, acquired, rendered)) = swapchain.acquire()? else {
             return self.recreate_swapchain();
         };
-        let target = swapchain.target(index, depth, [0.02, 0.03, 0.06, 1.0]);
+        let target = swapchain.target(index, depth, crate::render::SPACE_CLEAR);
         if let (Some(overlay), Some(window)) = (&mut self.overlay, &self.window) {
             overlay.prepare(self.ctx, window, renderer, (&info, &self.last_stats))?;
         }

@@ -45,7 +45,7 @@ impl App<'_> {
                 };
                 let stats = renderer.render_with_overlay(
                     &camera,
-                    &target.target([0.02, 0.03, 0.06, 1.0]),
+                    &target.target(crate::render::SPACE_CLEAR),
                     Access::ColorAttachment,
                     (&[], &[]),
                     Some(&mut draw_overlay),
