@@ -15,26 +15,6 @@ layout(constant_id = 1) const uint LAKE_MAP = 0;
 
 layout(location = 0) out vec4 outColor;
 
-// Cheap value noise for procedural texture detail (no external assets). The hash of a lattice point is
-// fract(x * y * z * (x + y + z)) of its coordinates, each scrambled alone (`scramble`), so a cell's eight corners
-// scramble six coordinates, not twenty-four (docs/rendering.md, "Cheaper pixels").
-vec3 scramble(vec3 p) { return fract(p * 0.3183099 + 0.1) * 17.0; }
-
-float hashScrambled(float x, float y, float z) { return fract(x * y * z * (x + y + z)); }
-
-// The hashes of a cell's eight corners from its scrambled low (`a`) and high (`b`) coordinates, corner k at
-// (k & 1, (k >> 1) & 1, k >> 2).
-void cornerHashes(vec3 a, vec3 b, out float c[8]) {
-    c[0] = hashScrambled(a.x, a.y, a.z);
-    c[1] = hashScrambled(b.x, a.y, a.z);
-    c[2] = hashScrambled(a.x, b.y, a.z);
-    c[3] = hashScrambled(b.x, b.y, a.z);
-    c[4] = hashScrambled(a.x, a.y, b.z);
-    c[5] = hashScrambled(b.x, a.y, b.z);
-    c[6] = hashScrambled(a.x, b.y, b.z);
-    c[7] = hashScrambled(b.x, b.y, b.z);
-}
-
 const vec3 DIRT = vec3(0.45, 0.36, 0.25);
 const vec3 SAND = vec3(0.76, 0.70, 0.50);
 const vec3 GRASS = vec3(0.26, 0.45, 0.18);
@@ -42,17 +22,6 @@ const vec3 ROCK = vec3(0.42, 0.40, 0.38);
 const vec3 SNOW = vec3(0.93, 0.94, 0.97);
 const vec3 WATER_SHALLOW = vec3(0.12, 0.42, 0.55);
 const vec3 WATER_DEEP = vec3(0.02, 0.10, 0.28);
-
-// Value noise whose lattice repeats every `period` cells.
-float periodicNoise(vec3 x, float period) {
-    vec3 i = floor(x);
-    vec3 f = fract(x);
-    f = f * f * (3.0 - 2.0 * f);
-    float c[8];
-    cornerHashes(scramble(mod(i, period)), scramble(mod(i + 1.0, period)), c);
-    return mix(mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y), mix(mix(c[4], c[5], f.x), mix(c[6], c[7], f.x), f.y),
-               f.z);
-}
 
 // Beyond the thesis (terrain close up): detail below the vertex spacing, three octaves of value noise from one
 // world unit down to 1/16, each fading out while its cells shrink from about three pixels to one and a half
@@ -85,18 +54,87 @@ float groundDetail() {
     return clamp(0.5 + sum / 1.4, 0.0, 1.0);
 }
 
+// Beyond the thesis (docs/rendering.md, "Climate"): what the climate makes of a place, from its latitude and the
+// moisture field its vertices computed (noise.glsl, moistureAt).
+const vec3 FOREST = vec3(0.13, 0.27, 0.10);
+const vec3 STEPPE = vec3(0.53, 0.48, 0.30);
+const vec3 DESERT = vec3(0.80, 0.67, 0.46);
+const vec3 TUNDRA = vec3(0.41, 0.39, 0.31);
+const vec3 SEA_ICE = vec3(0.86, 0.90, 0.95);
+// Snow and land ice, darker than Fig. 8.2's snow so that sunlit slopes stay below white and the relief shows.
+const vec3 ICE = vec3(0.78, 0.81, 0.86);
+
+struct Climate {
+    float latitude;  // degrees from the equator, either side
+    float moisture;  // the large-scale noise field, in [0, 1]
+    float aridity;   // 0 wet (rain forest) to 1 (desert)
+    float snowLine;  // in colour-band units above sea level
+};
+
+Climate climateAt(vec3 up, float moisture) {
+    Climate c;
+    c.latitude = degrees(asin(min(abs(up.y), 1.0)));
+    c.moisture = moisture;
+    // The subtropical dry belts under the Hadley cells' descending air, centred near 26 degrees (the Sahara,
+    // Arabia, Australia, the Kalahari, the Atacama), between the wet tropics and the mid-latitudes' storm tracks.
+    float fromBelt = (c.latitude - 26.0) * (1.0 / 11.0);
+    float belt = exp(-fromBelt * fromBelt);
+    c.aridity = clamp(belt * 0.9 + (c.moisture - 0.5) * 2.6, 0.0, 1.0);
+    // The snow line: about 5 km (10 units of 500 m on Earth) in the tropics, 3.8 km at 45 degrees, 1.5 km at 60,
+    // down to sea level past 72 (Greenland's and Antarctica's ice); up to 1.25 km higher where the air is dry (the
+    // Andes' dry belt, Tibet), as Earth's equilibrium lines lie.
+    c.snowLine = 11.0 * (1.0 - smoothBand(28.0, 80.0, c.latitude)) + 2.5 * c.aridity - 0.6;
+    return c;
+}
+
+// Beyond the thesis: Fig. 8.2's bands placed by climate. Vegetation by aridity (forest, grassland, steppe,
+// desert); tundra below the snow line's lowest few units, bare rock in the mountains just under it, snow and ice
+// above it; sand on the beaches only.
+vec3 climateColour(float h, float shore, Climate c) {
+    vec3 vegetation = mix(FOREST, GRASS, smoothBand(0.15, 0.4, c.aridity));
+    vegetation = mix(vegetation, STEPPE, smoothBand(0.45, 0.62, c.aridity));
+    vegetation = mix(vegetation, DESERT, smoothBand(0.65, 0.85, c.aridity));
+    float below = c.snowLine - h;
+    vec3 colour = mix(vegetation, TUNDRA, 1.0 - smoothBand(1.0, 3.5, below));
+    colour = mix(colour, ROCK, (1.0 - smoothBand(0.2, 1.5, below)) * smoothBand(2.0, 5.0, h));
+    colour = mix(colour, ICE, smoothBand(-0.8, 0.8, -below));
+    return mix(SAND, colour, smoothBand(0.0, 0.03, shore));
+}
+
+// Beyond the thesis ("Climate"): the polar sea frozen over `water`, from about 72 degrees (the Arctic's summer ice
+// edge lies near 75-80, its winter edge near 60-70; Antarctica's sea ice reaches 55-65 in winter), lit as flat
+// ground; `detail` the ground detail (0.5 for none).
+vec4 withSeaIce(vec4 water, Climate c, vec3 up, vec3 sun, float detail) {
+    if (c.latitude < 55.0) return water;
+    // The edge wanders by about ten degrees with the moisture field, and frays at a few hundred kilometres.
+    float fray = periodicNoise(up * 40.0 + 3.0, 256.0);
+    float edge = 74.0 + (c.moisture - 0.5) * 24.0 + (fray - 0.5) * 5.0;
+    float ice = smoothBand(-0.8, 0.8, c.latitude - edge);
+    float light = max(dot(up, sun), 0.0);
+    vec3 lit = (0.18 + 0.12 * max(light + 0.3, 0.0)) + 0.85 * light * fSunlight;
+    return mix(water, vec4(SEA_ICE * (0.85 + 0.3 * detail) * lit, 1.0), ice);
+}
+
 // Fig. 8.2: weights of the textures by height, with linear transitions; heights in units of frame.extra.z, so
-// that the bands keep their place relative to the mountains on any planet.
-vec3 terrainColour(float height, float slope, vec3 detail) {
+// that the bands keep their place relative to the mountains on any planet, `fray` of them from the ground detail.
+// With CLIMATE, the bands of `climateColour` instead.
+vec3 terrainColour(float height, float fray, float slope, vec3 detail, Climate climate) {
     float sea = frame.sun.w;
-    float h = (height - sea) / frame.extra.z;
-    vec3 c = mix(SAND, DIRT, smoothBand(0.0, 0.6, h));
-    c = mix(c, GRASS, smoothBand(0.4, 1.4, h));
-    c = mix(c, ROCK, smoothBand(6.0, 9.0, h));
-    c = mix(c, SNOW, smoothBand(12.0, 14.5, h));
+    float h = (height + fray * frame.extra.z - sea) / frame.extra.z;
+    vec3 c;
+    if (CLIMATE == 1u) {
+        c = climateColour(h, h - fray, climate);
+    } else {
+        c = mix(SAND, DIRT, smoothBand(0.0, 0.6, h));
+        c = mix(c, GRASS, smoothBand(0.4, 1.4, h));
+        c = mix(c, ROCK, smoothBand(6.0, 9.0, h));
+        c = mix(c, SNOW, smoothBand(12.0, 14.5, h));
+    }
     // Steep slopes show rock (8.3).
     c = mix(c, ROCK * 0.9, smoothBand(0.55, 0.8, slope));
-    if (h < 0.0) c = mix(SAND, DIRT * 0.6, clamp(-h / 3.0, 0.0, 1.0));
+    // Under the sea (with CLIMATE by the height itself: frayed, the coastal plains were spotted with sea floor).
+    float under = CLIMATE == 1u ? h - fray : h;
+    if (under < 0.0) c = mix(SAND, DIRT * 0.6, clamp(-under / 3.0, 0.0, 1.0));
     return c * (0.7 + 0.6 * detail);
 }
 
@@ -337,6 +375,7 @@ void main() {
         float depth = carved ? riverLookDepth() : max(fRiver.y - fRiver.x, 0.0);
         float opacity = carved ? riverOpacity(abs(fRiver.z) / fRiver.w) : depthOpacity(depth);
         vec4 water = waterSurface(river, depth, opacity, q, visible, up, view, sun);
+        if (CLIMATE == 1u && !river) water = withSeaIce(water, climateAt(up, fMoisture), up, sun, 0.5);
         outColor = vec4(atmosphereOn() ? throughAir(water.rgb) : water.rgb, water.a);
         return;
     }
@@ -362,8 +401,10 @@ void main() {
     float slope = 1.0 - clamp(dot(normal, up), 0.0, 1.0);
     // The detail also frays the bands' and the rock's borders (by up to a colour-band unit and a tenth of slope).
     float detail = groundDetail();
-    vec3 albedo = terrainColour(fRiver.x + (detail - 0.5) * 2.0 * frame.extra.z, slope * 3.0 + (detail - 0.5) * 0.3,
-                                vec3(detail));
+    Climate climate = Climate(0.0, 0.0, 0.0, 0.0);
+    if (CLIMATE == 1u) climate = climateAt(up, fMoisture);
+    vec3 albedo = terrainColour(fRiver.x, (detail - 0.5) * 2.0, slope * 3.0 + (detail - 0.5) * 0.3, vec3(detail),
+                                climate);
     if (viewMode() == 1) albedo = mix(albedo, levelColour(fLevel), 0.6);
     vec3 diffuse = max(dot(normal, sun), 0.0) * fSunlight;
     float ambient = 0.18 + 0.12 * max(dot(up, sun) + 0.3, 0.0);
@@ -444,6 +485,7 @@ void main() {
         vec4 water = waterSurface(!standing, depth, opacity, standing ? seaQ : q, standing ? seaVisible : visible, up,
                                   view, sun);
         if (paintedWater && viewMode() == 2) water.rgb = vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse);
+        if (CLIMATE == 1u && seaWater) water = withSeaIce(water, climate, up, sun, detail);
         colour = mix(colour, water.rgb, water.a * cover);
     }
     outColor = vec4(throughAir(colour), 1.0);

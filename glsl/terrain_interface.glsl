@@ -2,6 +2,12 @@
 // vec4 slots: lavapipe's draw module and triangle setup work per slot, per vertex and per triangle, on one thread
 // (docs/rendering.md, "The patch mesh and the shaders"). Writers define TERRAIN_WRITER before including it.
 
+#include "noise.glsl"
+
+// Beyond the thesis: 1 where <terrain-colours> is `climate` (docs/rendering.md, "Climate"), 0 for Fig. 8.2's
+// height bands (every stage of the terrain's pipelines gets the same specialization constants).
+layout(constant_id = 2) const uint CLIMATE = 0;
+
 #ifdef TERRAIN_WRITER
 #define TERRAIN_IO out
 #else
@@ -16,9 +22,11 @@ layout(location = 4) TERRAIN_IO vec4 ioDetailSunR;      // world position mod DE
 layout(location = 5) TERRAIN_IO vec4 ioInscatterSunG;   // the air's inscattered light (display value); sunlight green
 layout(location = 6) TERRAIN_IO vec4 ioTransmittanceSunB; // the air's transmittance from the eye; sunlight blue
 // The water pass: river water (1) or not (0); the terrain pass: the distance to the banks of the river the vertex
-// measured (`bank`). The level, the vertex spacing: the same at a triangle's three vertices (so interpolated, not
-// flat, to share the slot); whether the vertex lies in a river basin (1) or not (0).
-layout(location = 7) TERRAIN_IO vec4 ioKindLevelSpacingBasin;
+// measured (`bank`). Twice the level plus whether the vertex lies in a river basin (1) or not (0): the level is the
+// same at a triangle's three vertices, so the interpolated sum splits again. The vertex spacing (the same at a
+// triangle's three vertices, so interpolated, not flat, to share the slot). The climate's moisture (0.5 without
+// CLIMATE).
+layout(location = 7) TERRAIN_IO vec4 ioKindLevelBasinSpacingMoisture;
 // Beyond the thesis: the two nearest rivers in their order, signed distance and half width each (riverPairAt in
 // terrain_vertex.glsl); the terrain pass paints their union where a triangle's vertices agree on them.
 layout(location = 8) TERRAIN_IO vec4 ioRiverPair;
@@ -51,7 +59,8 @@ void writeSurface(SurfaceVertex v) {
     ioDetailSunR = vec4(v.detail, v.sunlight.r);
     ioInscatterSunG = vec4(v.inscatter, v.sunlight.g);
     ioTransmittanceSunB = vec4(v.transmittance, v.sunlight.b);
-    ioKindLevelSpacingBasin = vec4(v.riverWater ? 1.0 : v.bank, v.level, v.spacing, v.inBasin ? 1.0 : 0.0);
+    ioKindLevelBasinSpacingMoisture = vec4(v.riverWater ? 1.0 : v.bank, 2.0 * v.level + (v.inBasin ? 1.0 : 0.0),
+                                           v.spacing, CLIMATE == 1u ? moistureAt(v.direction) : 0.5);
     ioRiverPair = v.pair;
 }
 #else
@@ -64,11 +73,14 @@ void writeSurface(SurfaceVertex v) {
 #define fSunlight vec3(ioDetailSunR.w, ioInscatterSunG.w, ioTransmittanceSunB.w)
 #define fInscatter ioInscatterSunG.xyz
 #define fTransmittance ioTransmittanceSunB.xyz
-#define fRiverWater ioKindLevelSpacingBasin.x
-#define fBank ioKindLevelSpacingBasin.x
-#define fLevel ioKindLevelSpacingBasin.y
-#define fSpacing ioKindLevelSpacingBasin.z
-// Above 0 where any vertex of the triangle lies in a river basin (the water pass's choice of river triangles).
-#define fNearBasin ioKindLevelSpacingBasin.w
+#define fRiverWater ioKindLevelBasinSpacingMoisture.x
+#define fBank ioKindLevelBasinSpacingMoisture.x
+// The interpolation may miss the level's exact double by a few ulps either way.
+#define fLevel floor(ioKindLevelBasinSpacingMoisture.y * 0.5 + 0.25)
+#define fSpacing ioKindLevelBasinSpacingMoisture.z
+#define fMoisture ioKindLevelBasinSpacingMoisture.w
+// Above 0 where any vertex of the triangle lies in a river basin (the water pass's choice of river triangles), less
+// a thousandth for the level's rounding (at level 24 a few millionths).
+#define fNearBasin (ioKindLevelBasinSpacingMoisture.y - 2.0 * fLevel - 1e-3)
 #define fRiverPair ioRiverPair
 #endif

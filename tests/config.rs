@@ -1,6 +1,6 @@
 //! The XML configuration: Appendix A as printed, and every class of bad input reported by element and range.
 
-use riverplanet::config::{Config, ConfigError, LodRule, ReliefModel, RiverModel};
+use riverplanet::config::{Config, ConfigError, LodRule, ReliefModel, RiverModel, TerrainColours};
 
 const APPENDIX_A: &str = include_str!("../config/thesis.xml");
 
@@ -65,7 +65,29 @@ fn the_shipped_files_load_from_disk_with_their_models() {
         let c = Config::load(&dir.join(file)).unwrap();
         assert_eq!(c.river.model, model, "{file}");
         assert_eq!(c.rendering.level_of_detail_rule, rule, "{file}");
+        // The thesis's model keeps the thesis's height bands; the drainage model's planets are coloured by climate.
+        let colours = if model == RiverModel::Thesis {
+            TerrainColours::Height
+        } else {
+            TerrainColours::Climate
+        };
+        assert_eq!(c.rendering.terrain_colours, colours, "{file}");
     }
+}
+
+#[test]
+fn the_terrain_colours_are_named_or_refused() {
+    let c = Config::parse(
+        &with("rendering-attributes", "terrain-colours", "Height"),
+        "t.xml",
+    )
+    .unwrap();
+    assert_eq!(c.rendering.terrain_colours, TerrainColours::Height);
+    let message = error_of(&with("rendering-attributes", "terrain-colours", "biomes"));
+    assert!(
+        message.contains("terrain-colours") && message.contains("height, climate"),
+        "{message}"
+    );
 }
 
 #[test]

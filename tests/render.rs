@@ -10,7 +10,7 @@ use riverplanet::{
         holes::{hole_check_clear, Holes},
         path::Flight,
     },
-    config::{Config, LodRule},
+    config::{Config, LodRule, TerrainColours},
     gpu::Context,
     render::{
         ground::Ground,
@@ -694,6 +694,57 @@ fn the_sky_is_blue_from_the_ground_and_distant_land_fades_into_it() {
     assert!(
         near > 3.0 * far && far < 30.0,
         "aerial perspective: with air the horizon's land is {far:.1} from the sky's colour, the near ground {near:.1}"
+    );
+    common::assert_no_validation_errors(ctx);
+}
+
+/// Beyond the thesis: terrain coloured by climate (the default planet's `terrain-colours`; docs/rendering.md,
+/// "Climate"). From orbit the pole is ice, sea or land, where Fig. 8.2's height bands draw sea and lowland there;
+/// the tropics have no ice.
+#[test]
+fn the_climate_puts_ice_at_the_poles_and_none_in_the_tropics() {
+    let Some(ctx) = common::gpu() else { return };
+    let world = world();
+    assert_eq!(
+        world.config.rendering.terrain_colours,
+        TerrainColours::Climate
+    );
+    let mut height_bands = world.config.clone();
+    height_bands.rendering.terrain_colours = TerrainColours::Height;
+    let size = [160, 120];
+    let r = world.planet.radius;
+    let view = |axis: DVec3, config: &Config| {
+        let camera = Camera::look_at(axis * r * 3.0, DVec3::ZERO, 45.0, 4.0 / 3.0, 10.0);
+        render_configured(ctx, (world, config), &camera, size, CLEAR, |_| {})
+    };
+    // The share of icy pixels (bright, hardly coloured) within `rows` rows and `columns` columns of the centre.
+    let ice = |image: &image::RgbaImage, rows: u32, columns: u32| {
+        let (cx, cy) = (size[0] / 2, size[1] / 2);
+        let pixels: Vec<_> = (cy - rows..cy + rows)
+            .flat_map(|y| (cx - columns..cx + columns).map(move |x| (x, y)))
+            .map(|(x, y)| image.get_pixel(x, y).0)
+            .collect();
+        let icy = pixels.iter().filter(|p| {
+            let (lo, hi) = (p[..3].iter().min().unwrap(), p[..3].iter().max().unwrap());
+            *lo > 150 && hi - lo < 45
+        });
+        icy.count() as f64 / pixels.len() as f64
+    };
+    // Within about 8 degrees of the north pole; along the equator, 8 degrees either side.
+    let pole = view(DVec3::Y, &world.config);
+    let pole_bands = view(DVec3::Y, &height_bands);
+    let equator = view(DVec3::X, &world.config);
+    pole.save(out_dir().join("climate-pole.png")).unwrap();
+    pole_bands
+        .save(out_dir().join("climate-pole-height-bands.png"))
+        .unwrap();
+    equator.save(out_dir().join("climate-equator.png")).unwrap();
+    let (at_pole, at_pole_bands) = (ice(&pole, 8, 8), ice(&pole_bands, 8, 8));
+    let in_tropics = ice(&equator, 8, 40);
+    eprintln!("ice: pole {at_pole:.2} (height bands {at_pole_bands:.2}), tropics {in_tropics:.3}");
+    assert!(
+        at_pole > 0.9 && at_pole_bands < 0.2 && in_tropics < 0.05,
+        "ice at the pole {at_pole:.2} (height bands {at_pole_bands:.2}), in the tropics {in_tropics:.3}"
     );
     common::assert_no_validation_errors(ctx);
 }

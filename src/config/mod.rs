@@ -259,6 +259,24 @@ impl crate::named::Named for LodRule {
     ];
 }
 
+/// How the terrain is coloured (8.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TerrainColours {
+    /// The thesis's Fig. 8.2 (the default of the thesis's model): sand, dirt, grass, rock and snow by height alone.
+    Height,
+    /// Beyond the thesis (the default of the drainage model; docs/rendering.md, "Climate"): the same bands moved by
+    /// latitude and aridity, as climate places them: a snow line that falls from the tropics to the poles (ice caps
+    /// and polar sea ice), tundra and alpine rock below it, deserts and steppe in the subtropical dry belts, forest
+    /// where it is wet, sand on the beaches only.
+    Climate,
+}
+
+impl crate::named::Named for TerrainColours {
+    const ALL: &'static [(&'static str, Self)] =
+        &[("height", Self::Height), ("climate", Self::Climate)];
+}
+
 /// `<rendering-attributes>`: Table 6.1 plus the run-time budgets.
 #[derive(Clone, Debug, Serialize)]
 pub struct RenderingConfig {
@@ -285,6 +303,8 @@ pub struct RenderingConfig {
     pub generation_budget_ms: f32,
     /// Memory of resident patch textures at most, in MB (with max-resident-patches, whichever is smaller).
     pub resident_memory_mb: u32,
+    /// How the terrain is coloured: the thesis's height bands or climate's.
+    pub terrain_colours: TerrainColours,
 }
 
 /// A whole configuration: the three sections of Table 6.1.
@@ -302,9 +322,9 @@ impl Config {
     /// The defaults of a file with `model`: Appendix A's values (`appendix_a`), and for the drainage model the
     /// values config/planet.xml was tuned with (docs/rivers.md): a river where 700
     /// square units drain, a quarter of the diamond-square detail (the relief carries the shape), at most four
-    /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples), and the
-    /// screen-space-error level of detail (docs/rendering.md; the
-    /// thesis's model keeps the thesis's Eq. 6.1).
+    /// samples per vertex spacing (a thousand rivers would give coarse patches millions of samples), the
+    /// screen-space-error level of detail and the climate's terrain colours (docs/rendering.md; the thesis's model
+    /// keeps the thesis's Eq. 6.1 and height bands).
     pub fn defaults_for(model: RiverModel) -> Self {
         let mut d = Self::appendix_a();
         d.river.model = model;
@@ -316,6 +336,7 @@ impl Config {
             d.river.samples_per_vertex_spacing = 4;
             d.river.stream_levels = 1;
             d.rendering.level_of_detail_rule = LodRule::ScreenSpaceError;
+            d.rendering.terrain_colours = TerrainColours::Climate;
         }
         d
     }
@@ -381,6 +402,7 @@ impl Config {
                 new_patches_per_frame: 64,
                 generation_budget_ms: 8.0,
                 resident_memory_mb: 256,
+                terrain_colours: TerrainColours::Height,
             },
         }
     }

@@ -201,6 +201,9 @@ const RENDERING: &[Param<RenderingConfig>] = &[
         choose(text, &mut c.level_of_detail_rule)
     }),
     Param::Number("pixel-error", Range::Positive, |c| &mut c.pixel_error),
+    Param::Choice("terrain-colours", |c, text| {
+        choose(text, &mut c.terrain_colours)
+    }),
     Param::Number("river-pixel-error", Range::NonNegative, |c| {
         &mut c.river_pixel_error
     }),

@@ -28,7 +28,7 @@ pub use self::stats::FrameStats;
 use super::mesh::{index_buffer, patch_mesh, PatchMesh, QuadrantMesh};
 use crate::shader_types::FramePush;
 use crate::{
-    config::{Config, LodRule},
+    config::{Config, LodRule, TerrainColours},
     gpu::{
         bindless::{Bindless, SlotLayer},
         frames::{FrameRing, FRAMES_IN_FLIGHT},
@@ -231,6 +231,7 @@ impl<'w> Renderer<'w> {
         // through them (docs/rendering.md, "Back faces and morphing"); the water pass has the geometry shader that
         // spawns water triangles, except for the cached patches, whose water triangles the vertex cache's passes
         // list (docs/rendering.md). Water is blended over the terrain, writes no depth and comes in either winding.
+        let climate = config.rendering.terrain_colours == TerrainColours::Climate;
         let pipeline = |name: &str, vertex, geometry, kind: SurfacePipeline, lakes: bool| {
             let water = kind == SurfacePipeline::Water;
             GraphicsPipeline::new(
@@ -242,7 +243,11 @@ impl<'w> Renderer<'w> {
                     fragment: shaders::TERRAIN_FRAG,
                     set_layouts: &layouts,
                     push_constant_bytes: std::mem::size_of::<FramePush>() as u32,
-                    specialization: bytemuck::bytes_of(&[water as u32, lakes as u32]),
+                    specialization: bytemuck::bytes_of(&[
+                        water as u32,
+                        lakes as u32,
+                        climate as u32,
+                    ]),
                     color_format,
                     depth_format,
                     depth_write: !water,
