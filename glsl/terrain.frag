@@ -63,6 +63,8 @@ const vec3 TUNDRA = vec3(0.41, 0.39, 0.31);
 const vec3 SEA_ICE = vec3(0.86, 0.90, 0.95);
 // Snow and land ice, darker than Fig. 8.2's snow so that sunlit slopes stay below white and the relief shows.
 const vec3 ICE = vec3(0.78, 0.81, 0.86);
+// Glacier ice where a river runs above the snow line: bluer than the snow, so that its course still shows.
+const vec3 GLACIER = vec3(0.62, 0.72, 0.82);
 
 struct Climate {
     float latitude;  // degrees from the equator, either side
@@ -101,18 +103,28 @@ vec3 climateColour(float h, float shore, Climate c) {
     return mix(SAND, colour, smoothBand(0.0, 0.03, shore));
 }
 
-// Beyond the thesis ("Climate"): the polar sea frozen over `water`, from about 72 degrees (the Arctic's summer ice
-// edge lies near 75-80, its winter edge near 60-70; Antarctica's sea ice reaches 55-65 in winter), lit as flat
-// ground; `detail` the ground detail (0.5 for none).
+// Beyond the thesis ("Climate"): the light on ice lying flat at `up` (as the terrain's: ambient and sunlight).
+vec3 iceLight(vec3 up, vec3 sun) {
+    float light = max(dot(up, sun), 0.0);
+    return (0.18 + 0.12 * max(light + 0.3, 0.0)) + 0.85 * light * fSunlight;
+}
+
+// The polar sea frozen over `water`, from about 74 degrees (the Arctic's summer ice edge lies near 75-80, its
+// winter edge near 60-70; Antarctica's sea ice reaches 55-65 in winter); `detail` the ground detail (0.5 for none).
 vec4 withSeaIce(vec4 water, Climate c, vec3 up, vec3 sun, float detail) {
     if (c.latitude < 55.0) return water;
     // The edge wanders by about ten degrees with the moisture field, and frays at a few hundred kilometres.
     float fray = periodicNoise(up * 40.0 + 3.0, 256.0);
     float edge = 74.0 + (c.moisture - 0.5) * 24.0 + (fray - 0.5) * 5.0;
     float ice = smoothBand(-0.8, 0.8, c.latitude - edge);
-    float light = max(dot(up, sun), 0.0);
-    vec3 lit = (0.18 + 0.12 * max(light + 0.3, 0.0)) + 0.85 * light * fSunlight;
-    return mix(water, vec4(SEA_ICE * (0.85 + 0.3 * detail) * lit, 1.0), ice);
+    return mix(water, vec4(SEA_ICE * (0.85 + 0.3 * detail) * iceLight(up, sun), 1.0), ice);
+}
+
+// Rivers and lakes above the snow line are ice, as the land around them (`height` the terrain's): lakes frozen
+// over, rivers glaciers that keep their course. Without it they were blue lines and pools in the ice sheets.
+vec4 withFreshIce(vec4 water, float height, Climate c, vec3 up, vec3 sun) {
+    float frozen = smoothBand(-0.8, 0.8, (height - frame.sun.w) / frame.extra.z - c.snowLine);
+    return mix(water, vec4(GLACIER * iceLight(up, sun), 1.0), frozen);
 }
 
 // Fig. 8.2: weights of the textures by height, with linear transitions; heights in units of frame.extra.z, so
@@ -375,7 +387,10 @@ void main() {
         float depth = carved ? riverLookDepth() : max(fRiver.y - fRiver.x, 0.0);
         float opacity = carved ? riverOpacity(abs(fRiver.z) / fRiver.w) : depthOpacity(depth);
         vec4 water = waterSurface(river, depth, opacity, q, visible, up, view, sun);
-        if (CLIMATE == 1u && !river) water = withSeaIce(water, climateAt(up, fMoisture), up, sun, 0.5);
+        if (CLIMATE == 1u) {
+            Climate climate = climateAt(up, fMoisture);
+            water = river ? withFreshIce(water, fRiver.x, climate, up, sun) : withSeaIce(water, climate, up, sun, 0.5);
+        }
         outColor = vec4(atmosphereOn() ? throughAir(water.rgb) : water.rgb, water.a);
         return;
     }
@@ -485,7 +500,10 @@ void main() {
         vec4 water = waterSurface(!standing, depth, opacity, standing ? seaQ : q, standing ? seaVisible : visible, up,
                                   view, sun);
         if (paintedWater && viewMode() == 2) water.rgb = vec3(0.9, 0.1, 0.1) * (ambient + 0.85 * diffuse);
-        if (CLIMATE == 1u && seaWater) water = withSeaIce(water, climate, up, sun, detail);
+        // The painted rivers shown red stay red (that view shows what is painted).
+        if (CLIMATE == 1u && !(paintedWater && viewMode() == 2)) {
+            water = seaWater ? withSeaIce(water, climate, up, sun, detail) : withFreshIce(water, fRiver.x, climate, up, sun);
+        }
         colour = mix(colour, water.rgb, water.a * cover);
     }
     outColor = vec4(throughAir(colour), 1.0);
