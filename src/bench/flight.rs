@@ -351,16 +351,22 @@ fn fly(
             let hole_pixels = if check_holes {
                 let image = target.read(ctx)?;
                 let holes = Holes::find(&image, &camera, inner);
-                let save = |dir: &std::path::Path, name: String| {
-                    let path = dir.join(name);
-                    crate::export::files::save_image(&holes.shown_on(&image), &path)
-                        .map_err(|e| GpuError::Invalid(e.to_string()))
-                };
-                if let (true, Some(dir)) = (holes.count() > 0, &options.hole_images) {
-                    save(dir, format!("holes-{frame:03}.png"))?;
-                }
-                if let Some(dir) = &options.frame_images {
-                    save(dir, format!("frame-{frame:03}.png"))?;
+                let hole_dir = options.hole_images.as_ref().filter(|_| holes.count() > 0);
+                let saves = [
+                    (hole_dir, format!("holes-{frame:03}.png")),
+                    (
+                        options.frame_images.as_ref(),
+                        format!("frame-{frame:03}.png"),
+                    ),
+                ];
+                // The picture is made once, and only when a file wants it.
+                let mut shown = None;
+                for (dir, name) in saves {
+                    if let Some(dir) = dir {
+                        let picture = shown.get_or_insert_with(|| holes.shown_on(&image));
+                        crate::export::files::save_image(picture, &dir.join(name))
+                            .map_err(|e| GpuError::Invalid(e.to_string()))?;
+                    }
                 }
                 Some(holes.count())
             } else {
